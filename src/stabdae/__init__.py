@@ -1,0 +1,38 @@
+"""stabdae: stability of the constraint manifold of constrained Lagrangian systems under
+numerical integration, after R. G. Mukharlyamov's constraint-perturbation equations.
+
+The public API is exactly what this module re-exports.
+"""
+
+from ._integrate import IntegrationWarning, integrate
+from ._laws import Law, LawError, baumgarte, matrix, none, theorem5, user
+from ._loading import load_model, scene_names
+from ._model import Model, ModelError
+from ._schemes import Scheme, SchemeError, euler, heun, midpoint, rk4, two_stage
+from ._status import Status
+from ._version import __version__
+
+__all__ = [
+    "IntegrationWarning",
+    "Law",
+    "LawError",
+    "Model",
+    "ModelError",
+    "Scheme",
+    "SchemeError",
+    "Status",
+    "__version__",
+    "baumgarte",
+    "euler",
+    "heun",
+    "integrate",
+    "load_model",
+    "matrix",
+    "midpoint",
+    "none",
+    "rk4",
+    "scene_names",
+    "theorem5",
+    "two_stage",
+    "user",
+]

@@ -1,0 +1,259 @@
+"""One trajectory of the stabilized equations with a fixed-step explicit Runge–Kutta scheme."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import xarray as xr
+from numba import njit
+
+from ._dataset import provenance, variable
+from ._laws import as_law, bind_law
+from ._model import Model
+from ._rhs import kernels_for
+from ._schemes import as_scheme
+from ._status import Status, status_flag_attrs
+
+__all__ = ["integrate", "IntegrationWarning"]
+
+_NONFINITE = int(Status.NONFINITE_STATE)
+
+
+class IntegrationWarning(RuntimeWarning):
+    """An integration stopped early; the dataset holds everything up to that step."""
+
+
+def integrator_for(model: Model, bound):
+    """The compiled single-trajectory loop for ``model`` under the law's kind (memoized)."""
+    key = ("integrate", bound.code, bound.fn)
+    cache = model._kernel_cache
+    if key not in cache:
+        cache[key] = _build_integrator(kernels_for(model, bound))
+    return cache[key]
+
+
+def _build_integrator(K):
+    rhs, residual, energy, make_workspace = K.rhs, K.residual, K.energy, K.make_workspace
+    N2, ng = 2 * K.n, K.ng
+
+    @njit
+    def step(x, t, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, stages, xs):
+        """One explicit RK step, ``x`` updated in place; returns a status code.
+
+        ``stages`` (s × 2n) and ``xs`` (2n) are scratch.  On a non-zero status ``x`` is
+        left as it was before the step.
+        """
+        s = tab_b.shape[0]
+        for i in range(s):
+            for l in range(N2):
+                acc = x[l]
+                for j in range(i):
+                    acc += tau * tab_a[i, j] * stages[j, l]
+                xs[l] = acc
+            st = rhs(t + tab_c[i] * tau, xs, p, law_mat, law_scal, ws, stages[i])
+            if st != 0:
+                return st
+        for l in range(N2):
+            acc = 0.0
+            for i in range(s):
+                acc += tab_b[i] * stages[i, l]
+            xs[l] = x[l] + tau * acc
+            if not math.isfinite(xs[l]):
+                return _NONFINITE
+        for l in range(N2):
+            x[l] = xs[l]
+        return 0
+
+    @njit
+    def integrate_kernel(x0, t0, tau, nsteps, save_every, p, law_mat, law_scal,
+                         tab_a, tab_b, tab_c, out_x, out_g, out_e):  # fmt: skip
+        """Integrate from ``x0`` for ``nsteps`` steps, saving every ``save_every`` steps.
+
+        Writes sample ``j`` (time ``t0 + j·save_every·τ``) into ``out_x[j]``, ``out_g[j]``
+        and ``out_e[j]``; samples after a failure are left untouched.  Returns
+        ``(status, steps completed)``.
+        """
+        ws = make_workspace()
+        stages = np.empty((tab_b.shape[0], N2))
+        xs = np.empty(N2)
+        g = np.empty(ng)
+        x = x0.copy()
+        j = 0
+        t = t0
+        for i in range(nsteps + 1):
+            if i > 0:
+                st = step(x, t, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, stages, xs)
+                if st != 0:
+                    return st, i - 1
+                t = t0 + i * tau  # from the step count, not accumulated
+            if i % save_every == 0:
+                residual(t, x, p, ws, g)
+                for l in range(N2):
+                    out_x[j, l] = x[l]
+                for l in range(ng):
+                    out_g[j, l] = g[l]
+                out_e[j] = energy(t, x, p, ws)
+                j += 1
+        return 0, nsteps
+
+    return integrate_kernel
+
+
+def _positive(value, name: str) -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"integrate: {name} must be a real number, got {value!r}") from None
+    if not (math.isfinite(out) and out > 0):
+        raise ValueError(f"integrate: {name} must be positive and finite, got {value!r}")
+    return out
+
+
+def _whole_multiple(total: float, unit: float, total_name: str, unit_name: str) -> int:
+    count = round(total / unit)
+    if count < 1 or abs(count * unit - total) > 1e-9 * max(total, unit):
+        lo, hi = max(1, math.floor(total / unit)), math.ceil(total / unit)
+        raise ValueError(
+            f"integrate: {total_name} = {total:g} must be a whole multiple of {unit_name} = "
+            f"{unit:g} (fixed steps; samples on the step grid); nearest: {lo * unit:g} or "
+            f"{hi * unit:g}"
+        )
+    return count
+
+
+def integrate(
+    model: Model,
+    x0=None,
+    law=None,
+    scheme="rk4",
+    tau: float = 1e-3,
+    t_end: float = 1.0,
+    save_dt: float | None = None,
+    *,
+    params=None,
+    t0: float | None = None,
+) -> xr.Dataset:
+    """Integrate one trajectory of the stabilized equations (3.1), (3.11).
+
+    Parameters
+    ----------
+    model : Model
+    x0 : array (2n,), optional
+        Initial state ``(q, v)``; default the model's reference state.  It need not be
+        consistent: the residual ``g(x0)`` then decays (or not) according to the law.
+    law : Law or @njit function
+        Constraint-perturbation law (``baumgarte(...)``, ``matrix(A)``, ``theorem5(...)``,
+        ``none()``, or a user ``A(t, x, p, out)``).
+    scheme : Scheme or str, default "rk4"
+        ``"euler"``, ``"midpoint"``/``"rk2"``, ``"heun"``, ``"rk4"`` or a :class:`Scheme`.
+    tau : float
+        Fixed step size τ.
+    t_end : float
+        Final time; ``t_end − t0`` must be a whole multiple of ``tau``.
+    save_dt : float, optional
+        Spacing of stored samples, a whole multiple of ``tau`` dividing the interval
+        (default: every step).
+    params : mapping or array, optional
+        Physical parameters overriding the model's defaults.
+    t0 : float, optional
+        Initial time (default ``model.t0``).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``x(time, state)``, ``residual(time, component)``, ``residual_norm(time)``
+        (max-norm, as in the paper), ``energy(time)`` when the model has one, and a
+        ``status`` attribute.  If the integration stops early (singular ``S``, non-finite
+        state, …) an :class:`IntegrationWarning` says why and when; the samples before the
+        failure are kept and later ones are NaN.
+
+    Examples
+    --------
+    >>> import stabdae
+    >>> model = stabdae.load_model("pendulum")
+    >>> ds = stabdae.integrate(model, None, stabdae.baumgarte(10.0, 1.0), "rk4", 1e-3, 2.0, 0.01)
+    """
+    if not isinstance(model, Model):
+        raise TypeError(f"integrate: model must be a stabdae.Model, got {type(model).__name__}")
+    if law is None:
+        raise ValueError("integrate: give a law, e.g. stabdae.baumgarte(omega=10.0, xi=1.0)")
+    law = as_law(law)
+    scheme = as_scheme(scheme)
+    p = model.param_vector(params)
+    t0 = model.t0 if t0 is None else float(t0)
+    tau = _positive(tau, "tau")
+    span = float(t_end) - t0
+    if not (math.isfinite(span) and span > 0):
+        raise ValueError(f"integrate: t_end must be after t0 = {t0}, got t_end = {t_end!r}")
+    nsteps = _whole_multiple(span, tau, "t_end - t0", "tau")
+    save_dt = tau if save_dt is None else _positive(save_dt, "save_dt")
+    save_every = _whole_multiple(save_dt, tau, "save_dt", "tau")
+    if nsteps % save_every:
+        raise ValueError(
+            f"integrate: t_end - t0 = {span:g} must be a whole multiple of save_dt = {save_dt:g}"
+        )
+    if x0 is None:
+        x0 = model.reference_state(p)
+    x0 = np.array(x0, dtype=np.float64)
+    if x0.shape != (2 * model.n,):
+        raise ValueError(
+            f"integrate: x0 must have shape (2n,) = ({2 * model.n},) for model {model.name!r}, "
+            f"got {x0.shape}"
+        )
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("integrate: x0 has non-finite entries")
+
+    bound = bind_law(law, model)
+    kernel = integrator_for(model, bound)
+    nsave = nsteps // save_every + 1
+    out_x = np.full((nsave, 2 * model.n), np.nan)
+    out_g = np.full((nsave, model.n_residual), np.nan)
+    out_e = np.full(nsave, np.nan)
+    status, done = kernel(
+        x0, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
+        scheme.A, scheme.b, scheme.c, out_x, out_g, out_e,
+    )  # fmt: skip
+    status = Status(status)
+    if status != Status.OK:
+        warnings.warn(
+            f"integrate({model.name}): stopped at step {done} (t = {t0 + done * tau:g}) of "
+            f"{nsteps}: {status.description}; samples up to there are kept, later ones are NaN",
+            IntegrationWarning,
+            stacklevel=2,
+        )
+    times = t0 + tau * save_every * np.arange(nsave)
+    return _trajectory_dataset(
+        model, p, law, scheme, times, out_x, out_g, out_e, status, done,
+        dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=save_dt, steps=nsteps),
+    )  # fmt: skip
+
+
+def _trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, run):
+    coords = {
+        "time": variable("time", times, "time", "s"),
+        "state": variable("state", model.state_names, "state component x = (q, v)", "1"),
+        "component": variable(
+            "component", model.component_names, "residual component g = (f, fdot, h) (3.2)", "1"
+        ),
+        "state_units": variable("state", model.state_units, "units of each state component", "1"),
+    }
+    data = {
+        "x": variable(
+            ("time", "state"), xs, "state x = (q, v)", "mixed (see state_units)",
+        ),  # fmt: skip
+        "residual": variable(
+            ("time", "component"), gs, "constraint residual g = (f, fdot, h) (3.2)",
+            "1", comment="in the units of each constraint function",
+        ),  # fmt: skip
+        "residual_norm": variable(
+            "time", np.max(np.abs(gs), axis=1), "max-norm of the constraint residual", "1"
+        ),
+    }
+    if model.energy is not None:
+        data["energy"] = variable("time", es, "energy (model's energy function)", "model units")
+    attrs = provenance(model, p, law, scheme, **run)
+    attrs.update(status=int(status), status_name=status.name.lower(), steps_completed=done)
+    attrs.update({f"status_{k}": v for k, v in status_flag_attrs().items()})
+    return xr.Dataset(data, coords=coords, attrs=attrs)

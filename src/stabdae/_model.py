@@ -1,0 +1,556 @@
+"""The model interface: a constrained Lagrangian system as a set of ``@njit`` functions.
+
+A model declares only the pieces its system has (CONTRACT §1, DESIGN §1–3):
+
+=========== ============================ ========= ==========================================
+piece       signature                    ``out``   when
+=========== ============================ ========= ==========================================
+mass        ``mass(t, q, p, out)``       (n, n)    omit for identity mass
+forces      ``forces(t, q, v, p, out)``  (n,)      always: γ of (3.3), ``M v̇ = Fᵀλ − γ``
+f           ``f(t, q, p, out)``          (m,)      m > 0
+f_q         ``f_q(t, q, p, out)``        (m, n)    m > 0
+f_t         ``f_t(t, q, p, out)``        (m,)      time-dependent holonomic constraints only
+f_accel     ``f_accel(t, q, v, p, out)`` (m,)      m > 0: ``(d/dt f_q) v + d/dt f_t``
+h           ``h(t, q, v, p, out)``       (k,)      k > 0 nonholonomic constraints
+h_q, h_v    ``(t, q, v, p, out)``        (k, n)    k > 0
+h_t         ``h_t(t, q, v, p, out)``     (k,)      time-dependent nonholonomic only
+energy      ``energy(t, q, v, p)``       float     optional, for drift diagnostics
+=========== ============================ ========= ==========================================
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numba.core.dispatcher import Dispatcher
+
+__all__ = ["Model", "ModelError"]
+
+
+class ModelError(ValueError):
+    """A model's functions disagree with its declared sizes, or are not usable."""
+
+
+#: piece -> (argument pattern, output shape as a function of (n, m, k), size that governs it)
+_PIECES: dict[str, tuple[str, Callable[[int, int, int], tuple[int, ...]], str]] = {
+    "mass": ("tqp", lambda n, m, k: (n, n), "n"),
+    "forces": ("tqvp", lambda n, m, k: (n,), "n"),
+    "f": ("tqp", lambda n, m, k: (m,), "m"),
+    "f_q": ("tqp", lambda n, m, k: (m, n), "m, n"),
+    "f_t": ("tqp", lambda n, m, k: (m,), "m"),
+    "f_accel": ("tqvp", lambda n, m, k: (m,), "m"),
+    "h": ("tqvp", lambda n, m, k: (k,), "k"),
+    "h_q": ("tqvp", lambda n, m, k: (k, n), "k, n"),
+    "h_v": ("tqvp", lambda n, m, k: (k, n), "k, n"),
+    "h_t": ("tqvp", lambda n, m, k: (k,), "k"),
+}
+_HOLONOMIC = ("f", "f_q", "f_t", "f_accel")
+_NONHOLONOMIC = ("h", "h_q", "h_v", "h_t")
+_REQUIRED_IF_M = ("f", "f_q", "f_accel")
+_REQUIRED_IF_K = ("h", "h_q", "h_v")
+
+# Marks output entries a function did not write.  Arithmetic on model data does not land
+# on this exact value, and unlike NaN it cannot be confused with a computed non-finite.
+_UNWRITTEN = -7.0e307
+
+
+@dataclass(frozen=True)
+class _Piece:
+    name: str
+    fn: Dispatcher
+
+
+class Model:
+    """A constrained Lagrangian system written as ``@njit`` functions.
+
+    Parameters
+    ----------
+    name : str
+        Short identifier, used in messages and dataset attributes.
+    n : int
+        Number of generalized coordinates ``q``; the state is ``x = (q, v)`` of size 2n.
+    m : int, default 0
+        Number of holonomic constraints ``f(q, t) = 0``.
+    k : int, default 0
+        Number of nonholonomic constraints ``h(q, v, t) = 0``.
+    params : mapping of str to float
+        Named physical parameters, in the order of the vector ``p`` the functions read.
+    reference_state : callable ``p -> x*`` or array of shape (2n,)
+        A consistent state ``x* = (q*, v*)`` with ``g(x*, t0) = 0``.
+    coordinates : sequence of str, optional
+        Names of the n coordinates (default ``q0, q1, …``).
+    coordinate_units : sequence of str, optional
+        CF units of each coordinate (default ``"1"``); velocities get ``"<unit> s-1"``.
+    mass, forces, f, f_q, f_t, f_accel, h, h_q, h_v, h_t, energy : numba dispatchers
+        The pieces of the model; see the module docstring for signatures.  ``forces`` is
+        required; the constraint pieces follow from ``m`` and ``k``; ``mass`` (identity
+        when absent), ``f_t``, ``h_t`` (scleronomic when absent) and ``energy`` are optional.
+    t0 : float, default 0.0
+        Time at which ``reference_state`` is consistent.
+
+    Raises
+    ------
+    ModelError
+        If a piece is missing, superfluous, not ``@njit``, writes an output of the wrong
+        shape, or returns a non-finite value at the reference state, or if the reference
+        state is not consistent.  Every message names the function, the shape expected and
+        the shape got.
+
+    Notes
+    -----
+    At construction every supplied function is called once at the reference state, first
+    as plain Python (so that an out-of-bounds write raises instead of corrupting memory)
+    and then compiled.  Derivatives are not checked here; use :meth:`check`.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        n: int,
+        m: int = 0,
+        k: int = 0,
+        *,
+        params: Mapping[str, float] | None = None,
+        reference_state: Callable[[np.ndarray], np.ndarray] | np.ndarray,
+        forces: Dispatcher,
+        mass: Dispatcher | None = None,
+        f: Dispatcher | None = None,
+        f_q: Dispatcher | None = None,
+        f_t: Dispatcher | None = None,
+        f_accel: Dispatcher | None = None,
+        h: Dispatcher | None = None,
+        h_q: Dispatcher | None = None,
+        h_v: Dispatcher | None = None,
+        h_t: Dispatcher | None = None,
+        energy: Dispatcher | None = None,
+        coordinates: Sequence[str] | None = None,
+        coordinate_units: Sequence[str] | None = None,
+        t0: float = 0.0,
+        description: str = "",
+    ):
+        self.name = str(name)
+        self.n, self.m, self.k = (self._count(v, s) for v, s in ((n, "n"), (m, "m"), (k, "k")))
+        if self.n < 1:
+            raise ModelError(f"Model {self.name!r}: n must be at least 1, got {n}")
+        if self.m + self.k < 1:
+            raise ModelError(
+                f"Model {self.name!r}: a model needs at least one constraint (m + k ≥ 1); "
+                f"got m={m}, k={k}"
+            )
+        if self.m + self.k > self.n:
+            raise ModelError(
+                f"Model {self.name!r}: r = m + k = {self.m + self.k} constraints on n = {self.n} "
+                "coordinates; the constraint matrix F (r×n) cannot have full row rank when r > n"
+            )
+        self.t0 = float(t0)
+        self.description = description
+        self.params = self._validate_params(params)
+        self.coordinates = self._validate_names(coordinates)
+        self.coordinate_units = self._validate_units(coordinate_units)
+
+        given = dict(
+            mass=mass, forces=forces, f=f, f_q=f_q, f_t=f_t, f_accel=f_accel,
+            h=h, h_q=h_q, h_v=h_v, h_t=h_t,
+        )  # fmt: skip
+        self._check_presence(given)
+        self.functions: dict[str, Dispatcher] = {}
+        for piece, fn in given.items():
+            if fn is not None:
+                self.functions[piece] = self._require_njit(piece, fn)
+        self.energy = self._require_njit("energy", energy) if energy is not None else None
+
+        p = self.default_params()
+        self._reference = reference_state
+        x_ref = self.reference_state(p)
+        self._probe_all(x_ref, p)
+        self._check_consistent(x_ref, p)
+        self._kernel_cache: dict = {}
+
+    # ----------------------------------------------------------------- properties
+    @property
+    def r(self) -> int:
+        """Number of rows of ``F``: ``m + k``."""
+        return self.m + self.k
+
+    @property
+    def n_residual(self) -> int:
+        """Number of residual components ``g = (f, ḟ, h)``: ``2m + k``."""
+        return 2 * self.m + self.k
+
+    @property
+    def has_mass(self) -> bool:
+        return "mass" in self.functions
+
+    @property
+    def time_dependent(self) -> bool:
+        """True when the constraints depend explicitly on time (``f_t`` or ``h_t`` given)."""
+        return "f_t" in self.functions or "h_t" in self.functions
+
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        return tuple(self.params)
+
+    @property
+    def state_names(self) -> list[str]:
+        return list(self.coordinates) + [f"{c}_dot" for c in self.coordinates]
+
+    @property
+    def state_units(self) -> list[str]:
+        return list(self.coordinate_units) + [_per_second(u) for u in self.coordinate_units]
+
+    @property
+    def component_names(self) -> list[str]:
+        """Labels of the residual components: ``f_i``, ``fdot_i``, ``h_i``."""
+        return (
+            [f"f_{i}" for i in range(self.m)]
+            + [f"fdot_{i}" for i in range(self.m)]
+            + [f"h_{i}" for i in range(self.k)]
+        )
+
+    def __repr__(self) -> str:
+        pieces = ", ".join(self.functions) + (", energy" if self.energy is not None else "")
+        return (
+            f"Model({self.name!r}, n={self.n}, m={self.m}, k={self.k}, "
+            f"params={dict(self.params)}, pieces=[{pieces}])"
+        )
+
+    # ----------------------------------------------------------------- parameters
+    def default_params(self) -> np.ndarray:
+        """The parameter vector ``p`` with the model's default values."""
+        return np.array(list(self.params.values()), dtype=np.float64)
+
+    def param_vector(self, values: Mapping[str, float] | np.ndarray | None = None) -> np.ndarray:
+        """The vector ``p``: defaults overridden by ``values`` (a mapping or a full vector)."""
+        p = self.default_params()
+        if values is None:
+            return p
+        if isinstance(values, Mapping):
+            for key, val in values.items():
+                if key not in self.params:
+                    raise ModelError(
+                        f"Model {self.name!r}: unknown parameter {key!r}; "
+                        f"known parameters: {list(self.params)}"
+                    )
+                p[self.param_names.index(key)] = _finite_float(val, f"parameter {key!r}")
+            return p
+        arr = np.asarray(values, dtype=np.float64)
+        if arr.shape != p.shape:
+            raise ModelError(
+                f"Model {self.name!r}: parameter vector must have shape {p.shape} "
+                f"({list(self.params)}), got {arr.shape}"
+            )
+        if not np.all(np.isfinite(arr)):
+            raise ModelError(f"Model {self.name!r}: parameter vector has non-finite entries")
+        return np.ascontiguousarray(arr)
+
+    def reference_state(self, p: np.ndarray | None = None) -> np.ndarray:
+        """The consistent state ``x* = (q*, v*)`` for parameters ``p`` (shape (2n,))."""
+        p = self.default_params() if p is None else p
+        ref = self._reference
+        x = np.asarray(ref(p) if callable(ref) else ref, dtype=np.float64)
+        if x.shape != (2 * self.n,):
+            raise ModelError(
+                f"Model {self.name!r}: reference_state must have shape (2n,) = ({2 * self.n},) "
+                f"for n={self.n}, got {x.shape}"
+            )
+        x = x.copy()
+        if not np.all(np.isfinite(x)):
+            raise ModelError(f"Model {self.name!r}: reference_state has non-finite entries: {x}")
+        return x
+
+    # ----------------------------------------------------------------- evaluation
+    def evaluate(self, piece: str, t: float, x: np.ndarray, p: np.ndarray | None = None):
+        """Call one piece at ``(t, x)`` and return a new array (Python-side helper).
+
+        Absent optional pieces evaluate to their neutral value (identity mass, zero
+        ``f_t``/``h_t``).  Not for hot loops.
+        """
+        p = self.default_params() if p is None else p
+        q, v = np.ascontiguousarray(x[: self.n]), np.ascontiguousarray(x[self.n :])
+        if piece == "energy":
+            if self.energy is None:
+                raise ModelError(f"Model {self.name!r} has no energy function")
+            return float(self.energy(float(t), q, v, p))
+        if piece not in _PIECES:
+            raise ModelError(f"unknown model piece {piece!r}; pieces: {list(_PIECES)}")
+        pattern, shape_of, _ = _PIECES[piece]
+        shape = shape_of(self.n, self.m, self.k)
+        fn = self.functions.get(piece)
+        if fn is None:
+            if piece == "mass":
+                return np.eye(self.n)
+            return np.zeros(shape)
+        out = np.zeros(shape)
+        args = (float(t), q, p) if pattern == "tqp" else (float(t), q, v, p)
+        fn(*args, out)
+        return out
+
+    def residual(self, x: np.ndarray, t: float | None = None, p: np.ndarray | None = None):
+        """The residual ``g = (f, ḟ, h)`` of (3.2) at state ``x``, shape (2m + k,)."""
+        t = self.t0 if t is None else t
+        v = np.asarray(x, dtype=np.float64)[self.n :]
+        parts = []
+        if self.m:
+            parts += [
+                self.evaluate("f", t, x, p),
+                self.evaluate("f_q", t, x, p) @ v + self.evaluate("f_t", t, x, p),
+            ]
+        if self.k:
+            parts.append(self.evaluate("h", t, x, p))
+        return np.concatenate(parts)
+
+    def constraint_matrix(self, x: np.ndarray, t: float | None = None, p=None) -> np.ndarray:
+        """``F`` (r×n): the rows ``f_q`` over the rows ``h_v`` (DESIGN §1)."""
+        t = self.t0 if t is None else t
+        rows = []
+        if self.m:
+            rows.append(self.evaluate("f_q", t, x, p))
+        if self.k:
+            rows.append(self.evaluate("h_v", t, x, p))
+        return np.vstack(rows)
+
+    def check(self, params=None, *, states: int = 3, radius: float = 1e-2, seed: int = 0,
+              rtol: float = 1e-6):  # fmt: skip
+        """Compare the derivative pieces with finite differences; see :func:`stabdae.check`."""
+        from ._check import check_model
+
+        return check_model(self, params, states=states, radius=radius, seed=seed, rtol=rtol)
+
+    # ----------------------------------------------------------------- validation
+    def _count(self, value, symbol: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+            raise ModelError(
+                f"Model {self.name!r}: {symbol} must be a non-negative integer, got {value!r}"
+            )
+        return int(value)
+
+    def _validate_params(self, params) -> dict[str, float]:
+        if params is None:
+            return {}
+        if not isinstance(params, Mapping):
+            raise ModelError(
+                f"Model {self.name!r}: params must be a mapping of names to floats, "
+                f"got {type(params).__name__}"
+            )
+        return {str(k): _finite_float(v, f"parameter {k!r}") for k, v in params.items()}
+
+    def _validate_names(self, coordinates) -> tuple[str, ...]:
+        if coordinates is None:
+            return tuple(f"q{i}" for i in range(self.n))
+        names = tuple(str(c) for c in coordinates)
+        if len(names) != self.n:
+            raise ModelError(
+                f"Model {self.name!r}: coordinates must name the n={self.n} coordinates, "
+                f"got {len(names)}: {list(names)}"
+            )
+        if len(set(names)) != len(names):
+            raise ModelError(f"Model {self.name!r}: coordinate names repeat: {list(names)}")
+        return names
+
+    def _validate_units(self, units) -> tuple[str, ...]:
+        if units is None:
+            return ("1",) * self.n
+        if isinstance(units, str):
+            return (units,) * self.n
+        out = tuple(str(u) for u in units)
+        if len(out) != self.n:
+            raise ModelError(
+                f"Model {self.name!r}: coordinate_units must have n={self.n} entries, "
+                f"got {len(out)}"
+            )
+        return out
+
+    def _check_presence(self, given: dict) -> None:
+        where = f"Model {self.name!r}"
+        if given["forces"] is None:
+            raise ModelError(f"{where}: forces(t, q, v, p, out) is required (γ of (3.3))")
+        for piece in _HOLONOMIC:
+            if self.m == 0 and given[piece] is not None:
+                raise ModelError(
+                    f"{where}: {piece} is given but m=0; declare the number of holonomic "
+                    "constraints m, or drop the function"
+                )
+        for piece in _NONHOLONOMIC:
+            if self.k == 0 and given[piece] is not None:
+                raise ModelError(
+                    f"{where}: {piece} is given but k=0; declare the number of nonholonomic "
+                    "constraints k, or drop the function"
+                )
+        if self.m:
+            missing = [p for p in _REQUIRED_IF_M if given[p] is None]
+            if missing:
+                raise ModelError(f"{where}: m={self.m} holonomic constraints need {missing}")
+        if self.k:
+            missing = [p for p in _REQUIRED_IF_K if given[p] is None]
+            if missing:
+                raise ModelError(f"{where}: k={self.k} nonholonomic constraints need {missing}")
+
+    def _require_njit(self, piece: str, fn) -> Dispatcher:
+        if isinstance(fn, Dispatcher):
+            return fn
+        kind = "a plain Python function" if callable(fn) else f"a {type(fn).__name__}"
+        raise ModelError(
+            f"Model {self.name!r}: {piece} must be an @njit function (a numba dispatcher), "
+            f"got {kind}; decorate it with @numba.njit"
+        )
+
+    def _probe_all(self, x: np.ndarray, p: np.ndarray) -> None:
+        q, v = x[: self.n].copy(), x[self.n :].copy()
+        t = self.t0
+        for piece, fn in self.functions.items():
+            pattern, shape_of, governs = _PIECES[piece]
+            args = (t, q, p) if pattern == "tqp" else (t, q, v, p)
+            probe_output(
+                f"Model {self.name!r}: {_call_signature(piece)}",
+                fn, args, shape_of(self.n, self.m, self.k),
+                f"{governs} from n={self.n}, m={self.m}, k={self.k}",
+            )  # fmt: skip
+        if self.energy is not None:
+            self._probe_energy(t, q, v, p)
+
+    def _probe_energy(self, t, q, v, p) -> None:
+        try:
+            e = self.energy(t, q, v, p)
+        except Exception as exc:
+            raise ModelError(
+                f"Model {self.name!r}: energy(t, q, v, p) failed at the reference state: "
+                f"{_first_lines(exc)}"
+            ) from exc
+        if not isinstance(e, (float, int, np.floating, np.integer)) or isinstance(e, bool):
+            raise ModelError(
+                f"Model {self.name!r}: energy(t, q, v, p) must return a float (shape ()), "
+                f"got {type(e).__name__} of shape {np.shape(e)}"
+            )
+        if not math.isfinite(e):
+            raise ModelError(
+                f"Model {self.name!r}: energy(t, q, v, p) returned {e} at the reference state"
+            )
+
+    def _check_consistent(self, x: np.ndarray, p: np.ndarray) -> None:
+        g = self.residual(x, self.t0, p)
+        scale = max(1.0, float(np.max(np.abs(x))))
+        tol = 1e-9 * scale
+        if np.max(np.abs(g)) > tol:
+            bad = {name: float(val) for name, val in zip(self.component_names, g) if abs(val) > tol}
+            raise ModelError(
+                f"Model {self.name!r}: reference_state is not on the constraint manifold at "
+                f"t0={self.t0}: residual components above {tol:.1e}: {bad}"
+            )
+
+
+# --------------------------------------------------------------------- helpers
+
+def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs: str) -> np.ndarray:
+    """Call ``fn(*args, out)`` once as Python and once compiled; check shape and finiteness.
+
+    ``where`` names the function in messages ("Model 'x': f(t, q, p, out)"), ``governs``
+    says which sizes fix ``shape``.  Running the Python version first means an
+    out-of-bounds write raises ``IndexError`` instead of corrupting memory; the compiled
+    call then compiles the function for the argument types the kernels use.
+    Returns the output of the compiled call.
+    """
+    out = np.full(shape, _UNWRITTEN)
+    try:
+        fn.py_func(*args, out)
+    except (IndexError, ValueError) as exc:
+        got = _written_shape(fn.py_func, args, shape)
+        raise ModelError(
+            f"{where} writes outside out: expected shape {shape} ({governs}), got {got} "
+            f"({type(exc).__name__}: {exc})"
+        ) from exc
+    except Exception:
+        # Not runnable as plain Python (numba-only features): probe a bounds-checked
+        # compilation of the same source instead.
+        out = _probe_boundscheck(where, fn, args, shape, governs)
+    unwritten = out == _UNWRITTEN
+    if unwritten.any():
+        got = _extent(~unwritten) if (~unwritten).any() else "nothing written"
+        raise ModelError(
+            f"{where} did not write every entry of out: expected shape {shape} ({governs}), "
+            f"got {got}; unwritten entries {_index_list(unwritten)}"
+        )
+    if not np.all(np.isfinite(out)):
+        raise ModelError(
+            f"{where} returned non-finite values at the reference state at entries "
+            f"{_index_list(~np.isfinite(out))}: {out.tolist()}"
+        )
+    compiled = np.zeros(shape)
+    try:
+        fn(*args, compiled)
+    except Exception as exc:  # numba typing errors come in many classes
+        raise ModelError(
+            f"{where} failed to compile or run with float64 scalars and C-contiguous float64 "
+            f"arrays (out of shape {shape}): {_first_lines(exc)}"
+        ) from exc
+    return compiled
+
+
+def _probe_boundscheck(where, fn, args, shape, governs) -> np.ndarray:
+    from numba import njit
+
+    checked = njit(boundscheck=True)(fn.py_func)
+    out = np.full(shape, _UNWRITTEN)
+    try:
+        checked(*args, out)
+    except IndexError as exc:
+        raise ModelError(
+            f"{where} writes outside out: expected shape {shape} ({governs}) ({exc})"
+        ) from exc
+    except Exception as exc:
+        raise ModelError(f"{where} failed at the reference state: {_first_lines(exc)}") from exc
+    return out
+
+def _per_second(unit: str) -> str:
+    return "s-1" if unit == "1" else f"{unit} s-1"
+
+
+def _finite_float(value, what: str) -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what} must be a real number, got {value!r}") from None
+    if not math.isfinite(out):
+        raise ModelError(f"{what} must be finite, got {value!r}")
+    return out
+
+
+def _call_signature(piece: str) -> str:
+    pattern = _PIECES[piece][0]
+    return f"{piece}({', '.join(pattern)}, out)"
+
+
+def _extent(mask: np.ndarray) -> tuple[int, ...]:
+    """Shape of the smallest leading block that contains every True entry of ``mask``."""
+    idx = np.argwhere(mask)
+    return tuple(int(i) + 1 for i in idx.max(axis=0))
+
+
+def _written_shape(py_func, args, shape) -> str:
+    """Shape a function writes, found by calling it on an enlarged buffer."""
+    padded = np.full(tuple(s + 8 for s in shape), _UNWRITTEN)
+    try:
+        py_func(*args, padded)
+    except Exception:
+        return "an unknown shape (it also fails on a larger buffer)"
+    written = padded != _UNWRITTEN
+    if not written.any():
+        return "nothing written"
+    got = _extent(written)
+    if got == padded.shape:
+        return "a shape that follows out.shape"
+    return str(got)
+
+
+def _index_list(mask: np.ndarray) -> str:
+    idx = [tuple(int(j) for j in i) for i in np.argwhere(mask)]
+    if len(idx) > 6:
+        return f"{idx[:6]} … ({len(idx)} in all)"
+    return str(idx)
+
+
+def _first_lines(exc: BaseException, n: int = 6) -> str:
+    lines = [ln for ln in str(exc).splitlines() if ln.strip()]
+    return f"{type(exc).__name__}: " + " | ".join(lines[:n])

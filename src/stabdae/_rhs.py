@@ -1,0 +1,256 @@
+"""The stabilized right-hand side (3.1), (3.11) compiled for one model and one law kind.
+
+Per evaluation (DESIGN §3)::
+
+    γ      = forces(t, q, v)                    (3.3)
+    F      = [f_q ; h_v]                        (r × n)
+    g      = (f, f_q v + f_t, h)                (3.2)
+    c      = (f_accel ; h_q v + h_t)            convective terms of (f̈, ḣ)
+    M      = L Lᵀ (Cholesky)                    skipped for identity mass
+    Y      = M⁻¹ Fᵀ,  z = M⁻¹ γ
+    S      = F Y                                (r × r, SPD when F has full row rank)
+    S λ    = A g − s,   s = c − F z             (3.11)
+    v̇      = Y λ − z,   q̇ = v
+
+so that ``(f̈; ḣ) = S λ + s = A g`` and the exact flow obeys ``ġ = Ã g`` (3.9).
+
+The kernel factory closes over the model's dispatchers and over compile-time flags (mass
+present, m, k, time dependence, law kind).  Absent pieces are replaced by no-op stubs
+behind branches on those constants, which LLVM removes: an identity-mass model compiles
+no factorization of ``M``, a model with ``k = 0`` no nonholonomic block, a scleronomic
+model no ``f_t`` call.  Every buffer lives in a workspace tuple allocated once per
+integration; an evaluation allocates nothing and returns a :class:`~stabdae.Status` code.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from ._laws import LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw
+from ._linalg import cholesky_inplace, cholesky_solve_columns, cholesky_solve_inplace
+from ._model import Model
+from ._status import Status
+
+# Relative pivot thresholds of the Cholesky factorizations: a pivot below RTOL·max|diag|
+# reports a singular matrix instead of producing huge or NaN multipliers.
+MASS_RTOL = 1e-14
+S_RTOL = 1e-12
+
+_OK = int(Status.OK)
+_SINGULAR_S = int(Status.SINGULAR_S)
+_MASS_NOT_SPD = int(Status.MASS_NOT_SPD)
+
+
+@njit(cache=True)
+def _noop4(a, b, c, out):  # stands in for an absent (t, q, p, out) piece
+    pass
+
+
+@njit(cache=True)
+def _noop5(a, b, c, d, out):  # stands in for an absent (t, q, v, p, out) piece
+    pass
+
+
+@njit(cache=True)
+def _nan_energy(t, q, v, p):
+    return math.nan
+
+
+Kernels = namedtuple("Kernels", "rhs residual energy make_workspace n m k ng")
+
+
+def kernels_for(model: Model, bound: BoundLaw) -> Kernels:
+    """Compiled ``rhs``, ``residual`` and ``energy`` for ``model`` under the law's kind.
+
+    Memoized on the model, since every new closure is a new compilation.  Numeric law data
+    (``A``, ``L``, gains) are runtime arguments, so sweeping them reuses the same kernels.
+    """
+    key = (bound.code, bound.fn)
+    cache = model._kernel_cache
+    if key not in cache:
+        cache[key] = _build(model, bound.code, bound.fn)
+    return cache[key]
+
+
+def _build(model: Model, law_code: int, law_fn) -> Kernels:
+    # Compile-time constants of the closure.
+    n, m, k = model.n, model.m, model.k
+    r, ng = m + k, 2 * m + k
+    fns = model.functions
+    HAS_MASS = "mass" in fns
+    HAS_FT = "f_t" in fns
+    HAS_HT = "h_t" in fns
+    LAW = law_code
+    mass = fns.get("mass", _noop4)
+    forces = fns["forces"]
+    f_fn = fns.get("f", _noop4)
+    f_q = fns.get("f_q", _noop4)
+    f_t = fns.get("f_t", _noop4)
+    f_accel = fns.get("f_accel", _noop5)
+    h_fn = fns.get("h", _noop5)
+    h_q = fns.get("h_q", _noop5)
+    h_v = fns.get("h_v", _noop5)
+    h_t = fns.get("h_t", _noop5)
+    law_A = law_fn if law_fn is not None else _noop4
+    energy_fn = model.energy if model.energy is not None else _nan_energy
+    mk, kk = max(m, 1), max(k, 1)  # buffers for absent blocks keep a harmless size 1
+
+    @njit
+    def make_workspace():
+        """Every buffer one right-hand-side evaluation needs, allocated once."""
+        return (
+            np.empty(n),  # 0 q
+            np.empty(n),  # 1 v
+            np.empty((n, n)),  # 2 M, then its Cholesky factor
+            np.empty(n),  # 3 γ, then z = M⁻¹γ
+            np.empty((mk, n)),  # 4 f_q
+            np.empty((kk, n)),  # 5 h_v
+            np.empty((kk, n)),  # 6 h_q
+            np.empty((n, r)),  # 7 Y = M⁻¹Fᵀ
+            np.empty((r, r)),  # 8 S, then its Cholesky factor
+            np.empty(r),  # 9 right side of (3.11), then λ
+            np.empty(ng),  # 10 g
+            np.empty(mk),  # 11 scratch of size m (f, f_t, f_accel)
+            np.empty(kk),  # 12 scratch of size k (h, h_t)
+            np.empty((r, ng)),  # 13 A of a user law
+            np.empty((kk, kk)),  # 14 W = h_v h_vᵀ (Theorem 5)
+            np.empty(kk),  # 15 L h (Theorem 5)
+        )
+
+    @njit
+    def residual(t, x, p, ws, g):
+        """g = (f, f_q v + f_t, h) of (3.2) into ``g``; fills ws q, v, f_q, h_v, h_q."""
+        q, v, fq, hv, hq, sm, sk = ws[0], ws[1], ws[4], ws[5], ws[6], ws[11], ws[12]
+        for i in range(n):
+            q[i] = x[i]
+            v[i] = x[n + i]
+        if m > 0:
+            f_fn(t, q, p, sm)
+            for i in range(m):
+                g[i] = sm[i]
+            f_q(t, q, p, fq)
+            if HAS_FT:
+                f_t(t, q, p, sm)
+            for i in range(m):
+                s = sm[i] if HAS_FT else 0.0
+                for j in range(n):
+                    s += fq[i, j] * v[j]
+                g[m + i] = s
+        if k > 0:
+            h_fn(t, q, v, p, sk)
+            for i in range(k):
+                g[2 * m + i] = sk[i]
+            h_v(t, q, v, p, hv)
+            h_q(t, q, v, p, hq)
+
+    @njit
+    def rhs(t, x, p, law_mat, law_scal, ws, xdot):
+        """Write ẋ of the stabilized system (3.1) into ``xdot``; return a status code.
+
+        ``law_mat``/``law_scal`` carry the law's runtime data (``A``; or ``L`` and the gain
+        of Theorem 5).  On a non-zero status ``xdot`` is undefined.  Nothing is checked:
+        shapes are fixed by the workspace.
+        """
+        q, v, Mw, z, fq, hv, hq = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6]
+        Y, S, rl, g, sm, sk = ws[7], ws[8], ws[9], ws[10], ws[11], ws[12]
+        Aw, W, Lh = ws[13], ws[14], ws[15]
+        residual(t, x, p, ws, g)
+        forces(t, q, v, p, z)
+
+        # Right side of (3.11): A g − c + F z (z = γ for now; the F z term is added below,
+        # after z = M⁻¹γ is known).
+        if LAW == LAW_CONSTANT:
+            for i in range(r):
+                s = 0.0
+                for j in range(ng):
+                    s += law_mat[i, j] * g[j]
+                rl[i] = s
+        elif LAW == LAW_USER:
+            law_A(t, x, p, Aw)
+            for i in range(r):
+                s = 0.0
+                for j in range(ng):
+                    s += Aw[i, j] * g[j]
+                rl[i] = s
+        elif LAW == LAW_THEOREM5:  # m = 0: A22 g = −k W L g with W = h_v h_vᵀ
+            for i in range(k):
+                s = 0.0
+                for j in range(k):
+                    s += law_mat[i, j] * g[j]
+                Lh[i] = s
+            for i in range(k):
+                for j in range(k):
+                    s = 0.0
+                    for l in range(n):
+                        s += hv[i, l] * hv[j, l]
+                    W[i, j] = s
+            for i in range(k):
+                s = 0.0
+                for j in range(k):
+                    s += W[i, j] * Lh[j]
+                rl[i] = -law_scal[0] * s
+        if m > 0:
+            f_accel(t, q, v, p, sm)
+            for i in range(m):
+                rl[i] -= sm[i]
+        if k > 0:
+            if HAS_HT:
+                h_t(t, q, v, p, sk)
+            for i in range(k):
+                s = sk[i] if HAS_HT else 0.0
+                for j in range(n):
+                    s += hq[i, j] * v[j]
+                rl[m + i] -= s
+
+        # Y = M⁻¹ Fᵀ and z = M⁻¹ γ
+        for i in range(m):
+            for j in range(n):
+                Y[j, i] = fq[i, j]
+        for i in range(k):
+            for j in range(n):
+                Y[j, m + i] = hv[i, j]
+        if HAS_MASS:
+            mass(t, q, p, Mw)
+            if cholesky_inplace(Mw, n, MASS_RTOL) != 0:
+                return _MASS_NOT_SPD
+            cholesky_solve_columns(Mw, n, Y, r)
+            cholesky_solve_inplace(Mw, n, z)
+
+        # S = F Y (symmetric; lower triangle suffices for Cholesky) and rl += F z
+        for i in range(r):
+            s = 0.0
+            for j in range(n):
+                fij = fq[i, j] if i < m else hv[i - m, j]
+                s += fij * z[j]
+            rl[i] += s
+            for c in range(i + 1):
+                s = 0.0
+                for j in range(n):
+                    fij = fq[i, j] if i < m else hv[i - m, j]
+                    s += fij * Y[j, c]
+                S[i, c] = s
+        if cholesky_inplace(S, r, S_RTOL) != 0:
+            return _SINGULAR_S
+        cholesky_solve_inplace(S, r, rl)  # rl is now λ
+
+        for j in range(n):
+            s = -z[j]
+            for i in range(r):
+                s += Y[j, i] * rl[i]
+            xdot[j] = v[j]
+            xdot[n + j] = s
+        return _OK
+
+    @njit
+    def energy(t, x, p, ws):
+        q, v = ws[0], ws[1]
+        for i in range(n):
+            q[i] = x[i]
+            v[i] = x[n + i]
+        return energy_fn(t, q, v, p)
+
+    return Kernels(rhs, residual, energy, make_workspace, n, m, k, ng)

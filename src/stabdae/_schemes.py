@@ -1,0 +1,208 @@
+"""Explicit Runge–Kutta schemes of the paper's §5, as validated Butcher tableaus.
+
+* Euler (5.1): ``x_{k+1} = x_k + τ v(x_k, t_k)``.
+* The two-stage family (5.4)–(5.7) with parameters ``a`` (the paper's α) and ``σ``::
+
+      x̄       = x_k + a τ v(x_k, t_k)
+      x_{k+1} = x_k + τ [(1 − σ) v(x_k, t_k) + σ v(x̄, t_k + a τ)]
+
+  second order iff ``2aσ = 1`` (midpoint: σ = 1, a = ½; Heun: σ = ½, a = 1).  (5.5) as
+  printed drops a τ on the second term; (5.9) has it, and so does this code.
+* Classical fourth-order Runge–Kutta, for reference solutions.
+
+Each scheme is a tableau ``(A, b, c)`` whose invariants (``Σb = 1``, ``A.sum(1) = c``,
+strictly lower-triangular ``A``, order conditions up to the declared order) are asserted
+once, when it is defined.  The compiled stepper reads the tableau as runtime arrays, so a
+new scheme never recompiles a kernel.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Scheme", "euler", "two_stage", "midpoint", "heun", "rk4", "as_scheme"]
+
+
+class SchemeError(ValueError):
+    """A Butcher tableau that breaks its invariants, or an unknown scheme name."""
+
+
+@dataclass(frozen=True, eq=False)
+class Scheme:
+    """An explicit Runge–Kutta scheme.
+
+    Attributes
+    ----------
+    name : str
+    A : float64[s, s]
+        Strictly lower-triangular coefficients.
+    b : float64[s]
+        Weights.
+    c : float64[s]
+        Nodes, ``c = A.sum(1)``.
+    order : int
+        Classical order, verified against the order conditions at construction.
+    params : dict
+        The parameters that define it (``a``, ``sigma`` for the two-stage family).
+    """
+
+    name: str
+    A: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    order: int
+    params: dict
+
+    def __post_init__(self):
+        A, b, c = (np.array(x, dtype=np.float64) for x in (self.A, self.b, self.c))
+        s = b.shape[0]
+        if A.shape != (s, s) or c.shape != (s,):
+            raise SchemeError(
+                f"scheme {self.name!r}: tableau shapes must be A (s, s), b (s,), c (s,); got "
+                f"A {A.shape}, b {b.shape}, c {c.shape}"
+            )
+        if np.any(np.triu(A) != 0):
+            raise SchemeError(f"scheme {self.name!r}: A must be strictly lower triangular")
+        if not math.isclose(b.sum(), 1.0, abs_tol=1e-14):
+            raise SchemeError(f"scheme {self.name!r}: weights must sum to 1, got {b.sum()}")
+        if not np.allclose(A.sum(axis=1), c, atol=1e-14):
+            raise SchemeError(f"scheme {self.name!r}: rows of A must sum to c")
+        got = _tableau_order(A, b, c)
+        if got != self.order:
+            raise SchemeError(
+                f"scheme {self.name!r}: declared order {self.order} but the order conditions "
+                f"hold up to order {got}"
+            )
+        for arr in (A, b, c):
+            arr.setflags(write=False)
+        object.__setattr__(self, "A", A)
+        object.__setattr__(self, "b", b)
+        object.__setattr__(self, "c", c)
+
+    @property
+    def stages(self) -> int:
+        return self.b.shape[0]
+
+    def stability_polynomial(self) -> np.ndarray:
+        """Coefficients ``[1, b·1, b·A1, b·A²1, …]`` of ``R(z) = Σ_j γ_j z^j`` (ascending).
+
+        For an explicit scheme ``R(z) = 1 + z bᵀ(I − zA)⁻¹ 1`` is a polynomial of degree s.
+        """
+        s = self.stages
+        coeffs = [1.0]
+        v = np.ones(s)
+        for _ in range(s):
+            coeffs.append(float(self.b @ v))
+            v = self.A @ v
+        return np.array(coeffs)
+
+    def attrs(self) -> dict:
+        return {"scheme": self.name, "scheme_order": self.order, **self.params}
+
+    def __repr__(self) -> str:
+        extra = "".join(f", {k}={v}" for k, v in self.params.items())
+        return f"Scheme({self.name!r}, order={self.order}{extra})"
+
+
+def _tableau_order(A, b, c, max_order: int = 4) -> int:
+    """Highest order ≤ 4 whose Butcher order conditions hold to 1e-12."""
+    e = np.ones_like(b)
+    conds = {
+        1: [b @ e - 1.0],
+        2: [b @ c - 1 / 2],
+        3: [b @ c**2 - 1 / 3, b @ (A @ c) - 1 / 6],
+        4: [
+            b @ c**3 - 1 / 4,
+            b @ (c * (A @ c)) - 1 / 8,
+            b @ (A @ c**2) - 1 / 12,
+            b @ (A @ (A @ c)) - 1 / 24,
+        ],
+    }
+    order = 0
+    for p in range(1, max_order + 1):
+        if all(abs(x) < 1e-12 for x in conds[p]):
+            order = p
+        else:
+            break
+    return order
+
+
+def euler() -> Scheme:
+    """Explicit Euler (5.1), order 1."""
+    return Scheme("euler", [[0.0]], [1.0], [0.0], 1, {})
+
+
+def two_stage(a: float, sigma: float, *, name: str | None = None) -> Scheme:
+    """The two-stage family (5.4)–(5.7) with parameters ``a`` (paper: α) and ``σ``.
+
+    Second order iff ``2aσ = 1``; otherwise first order and a ``UserWarning`` says so.
+
+    Examples
+    --------
+    >>> two_stage(0.5, 1.0).order      # the midpoint rule
+    2
+    """
+    try:
+        a, sigma = float(a), float(sigma)
+    except (TypeError, ValueError):
+        raise SchemeError(f"two_stage: a and sigma must be real numbers, got {a!r}, {sigma!r}")
+    if not (math.isfinite(a) and math.isfinite(sigma)):
+        raise SchemeError(f"two_stage: a and sigma must be finite, got a={a}, sigma={sigma}")
+    if sigma != 0.0 and a == 0.0:
+        raise SchemeError("two_stage: a = 0 with sigma ≠ 0 evaluates the same stage twice")
+    order = 2 if math.isclose(2 * a * sigma, 1.0, rel_tol=0, abs_tol=1e-12) else 1
+    if order == 1:
+        warnings.warn(
+            f"two_stage(a={a}, sigma={sigma}): 2·a·σ = {2 * a * sigma:g} ≠ 1, so the scheme is "
+            "only first order (see (5.9)–(5.13))",
+            UserWarning,
+            stacklevel=2,
+        )
+    return Scheme(
+        name or "two_stage",
+        [[0.0, 0.0], [a, 0.0]],
+        [1.0 - sigma, sigma],
+        [0.0, a],
+        order,
+        {"a": a, "sigma": sigma},
+    )
+
+
+def midpoint() -> Scheme:
+    """Two-stage scheme with σ = 1, a = ½ (explicit midpoint rule), order 2."""
+    return two_stage(0.5, 1.0, name="midpoint")
+
+
+def heun() -> Scheme:
+    """Two-stage scheme with σ = ½, a = 1 (Heun's method), order 2."""
+    return two_stage(1.0, 0.5, name="heun")
+
+
+def rk4() -> Scheme:
+    """The classical fourth-order Runge–Kutta scheme."""
+    A = [[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]]
+    return Scheme("rk4", A, [1 / 6, 1 / 3, 1 / 3, 1 / 6], [0, 0.5, 0.5, 1], 4, {})
+
+
+_BY_NAME = {"euler": euler, "midpoint": midpoint, "rk2": midpoint, "heun": heun, "rk4": rk4}
+
+
+def as_scheme(scheme, **params) -> Scheme:
+    """A :class:`Scheme` from a scheme or a name (``euler``, ``rk2``/``midpoint``, ``heun``,
+    ``two_stage`` with ``a`` and ``sigma``, ``rk4``)."""
+    if isinstance(scheme, Scheme):
+        return scheme
+    if isinstance(scheme, str):
+        key = scheme.lower()
+        if key in ("two_stage", "rk2") and params:
+            return two_stage(params.get("a", 0.5), params.get("sigma", 1.0))
+        if key in _BY_NAME:
+            return _BY_NAME[key]()
+        raise SchemeError(
+            f"unknown scheme {scheme!r}; known: {sorted(set(_BY_NAME) | {'two_stage'})}"
+        )
+    raise SchemeError(f"scheme must be a Scheme or a name, got {type(scheme).__name__}")
