@@ -457,10 +457,13 @@ def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs:
         fn.py_func(*args, out)
     except (IndexError, ValueError) as exc:
         got = _written_shape(fn.py_func, args, shape)
-        raise ModelError(
-            f"{where} writes outside out: expected shape {shape} ({governs}), got {got} "
-            f"({type(exc).__name__}: {exc})"
-        ) from exc
+        if got is None:  # fails on a larger buffer too: not a shape problem
+            out = _probe_boundscheck(where, fn, args, shape, governs)
+        else:
+            raise ModelError(
+                f"{where} writes outside out: expected shape {shape} ({governs}), got {got} "
+                f"({type(exc).__name__}: {exc})"
+            ) from exc
     except Exception:
         # Not runnable as plain Python (numba-only features): probe a bounds-checked
         # compilation of the same source instead.
@@ -528,13 +531,14 @@ def _extent(mask: np.ndarray) -> tuple[int, ...]:
     return tuple(int(i) + 1 for i in idx.max(axis=0))
 
 
-def _written_shape(py_func, args, shape) -> str:
-    """Shape a function writes, found by calling it on an enlarged buffer."""
+def _written_shape(py_func, args, shape) -> str | None:
+    """Shape a function writes, found by calling it on an enlarged buffer (None if that
+    call fails too)."""
     padded = np.full(tuple(s + 8 for s in shape), _UNWRITTEN)
     try:
         py_func(*args, padded)
     except Exception:
-        return "an unknown shape (it also fails on a larger buffer)"
+        return None
     written = padded != _UNWRITTEN
     if not written.any():
         return "nothing written"

@@ -1,0 +1,124 @@
+"""model.check(): finite differences catch wrong derivative pieces and name them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numba import njit
+
+import stabdae
+from conftest import SCENES, load_scene
+
+KNIFE = load_scene("knife_edge")
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_scenes_pass_check(name):
+    report = load_scene(name).check(states=3)
+    assert report.ok, str(report)
+    assert {row.piece for row in report.rows} >= ({"f_q", "f_accel"} if "f" in
+        load_scene(name).functions else {"h_q", "h_v"})  # fmt: skip
+
+
+@njit
+def forces(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = 9.81
+
+
+@njit
+def f(t, q, p, out):
+    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
+
+
+@njit
+def f_q(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+
+
+@njit
+def f_q_wrong(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = q[1]  # should be 2 y
+
+
+@njit
+def f_accel(t, q, v, p, out):
+    out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
+
+
+@njit
+def f_accel_wrong(t, q, v, p, out):
+    out[0] = v[0] * v[0] + v[1] * v[1]  # factor 2 missing
+
+
+@njit
+def f_moving(t, q, p, out):
+    out[0] = q[0] * q[0] + q[1] * q[1] - (1.0 + 0.1 * t) ** 2
+
+
+@njit
+def mass_indefinite(t, q, p, out):
+    out[0, 0] = 1.0
+    out[0, 1] = 0.0
+    out[1, 0] = 0.0
+    out[1, 1] = -1.0
+
+
+@njit
+def mass_asymmetric(t, q, p, out):
+    out[0, 0] = 1.0
+    out[0, 1] = 0.5
+    out[1, 0] = 0.0
+    out[1, 1] = 1.0
+
+
+X_REF = np.array([0.0, -1.0, 1.0, 0.0])
+
+
+def pendulum(**overrides):
+    kwargs = dict(n=2, m=1, reference_state=X_REF, forces=forces, f=f, f_q=f_q, f_accel=f_accel)
+    kwargs.update(overrides)
+    return stabdae.Model("test_pendulum", **kwargs)
+
+
+def test_check_names_wrong_f_q():
+    report = pendulum(f_q=f_q_wrong).check()
+    assert not report.ok
+    assert "f_q" in report.failures
+    assert "pieces that disagree: f_q" in str(report)
+
+
+def test_check_names_wrong_f_accel():
+    report = pendulum(f_accel=f_accel_wrong).check()
+    assert report.failures == ["f_accel"]
+
+
+def test_check_names_missing_time_derivative():
+    """f depends on t but the model declares no f_t: f_t (and f_accel) disagree."""
+    model = pendulum(f=f_moving, reference_state=X_REF)
+    assert "f_t" in model.check().failures
+
+
+def test_check_mass_matrix():
+    assert pendulum(mass=mass_indefinite).check().failures == ["mass"]
+    report = pendulum(mass=mass_asymmetric).check()
+    assert report.failures == ["mass"]
+    assert "symmetry" in str(report)
+
+
+def test_check_nonholonomic_pieces():
+    """A wrong h_q in the knife edge is caught and named."""
+
+    @njit
+    def h_q_wrong(t, q, v, p, out):
+        out[0, 0] = 0.0
+        out[0, 1] = 0.0
+        out[0, 2] = np.cos(q[2]) * v[0]  # missing + sin φ ẏ
+
+    fns = dict(KNIFE.functions)
+    fns["h_q"] = h_q_wrong
+    model = stabdae.Model("knife_wrong", 3, 0, 1, params=KNIFE.params,
+                          reference_state=KNIFE.reference_state, **fns)  # fmt: skip
+    assert model.check().failures == ["h_q"]

@@ -1,0 +1,266 @@
+"""Every error message of the model, law, scheme and integrate interfaces."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numba import njit
+
+import stabdae
+from conftest import load_scene
+
+# ---------------------------------------------------------------- a pendulum to break
+
+
+@njit
+def forces(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = 9.81
+
+
+@njit
+def f(t, q, p, out):
+    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
+
+
+@njit
+def f_q(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+
+
+@njit
+def f_accel(t, q, v, p, out):
+    out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
+
+
+@njit
+def f_two_rows(t, q, p, out):
+    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
+    out[1] = q[0]
+
+
+@njit
+def f_q_three_columns(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+    out[0, 2] = 0.0
+
+
+@njit
+def f_q_one_column(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+
+
+@njit
+def forces_nan(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = np.nan
+
+
+@njit
+def forces_bad_types(t, q, v, p, out):
+    out[0] = "text"  # cannot compile
+    out[1] = 0.0
+
+
+@njit
+def mass_identity(t, q, p, out):
+    out[:, :] = 0.0
+    out[0, 0] = 1.0
+    out[1, 1] = 1.0
+
+
+@njit
+def energy_array(t, q, v, p):
+    return np.zeros(2)
+
+
+def forces_plain(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = 9.81
+
+
+X_REF = np.array([0.0, -1.0, 1.0, 0.0])
+
+
+def build(**overrides):
+    kwargs = dict(
+        n=2, m=1, reference_state=X_REF, forces=forces, f=f, f_q=f_q, f_accel=f_accel
+    )
+    kwargs.update(overrides)
+    return stabdae.Model("broken", **kwargs)
+
+
+def test_valid_model_builds():
+    assert build().r == 1
+
+
+def test_output_with_too_many_rows():
+    with pytest.raises(
+        stabdae.ModelError,
+        match=r"f\(t, q, p, out\) writes outside out: expected shape \(1,\) \(m from n=2, m=1, "
+        r"k=0\), got \(2,\)",
+    ):
+        build(f=f_two_rows)
+
+
+def test_output_with_too_many_columns():
+    with pytest.raises(
+        stabdae.ModelError, match=r"f_q\(t, q, p, out\) writes outside out: expected shape "
+        r"\(1, 2\) .*got \(1, 3\)"
+    ):  # fmt: skip
+        build(f_q=f_q_three_columns)
+
+
+def test_output_partly_unwritten():
+    with pytest.raises(
+        stabdae.ModelError,
+        match=r"f_q\(t, q, p, out\) did not write every entry of out: expected shape \(1, 2\) "
+        r".*got \(1, 1\); unwritten entries \[\(0, 1\)\]",
+    ):
+        build(f_q=f_q_one_column)
+
+
+def test_counts_disagree_with_functions():
+    """m = 2 declared, f writes one row: the shape got is named."""
+    with pytest.raises(stabdae.ModelError, match=r"expected shape \(2,\) .*got \(1,\)"):
+        build(m=2)
+
+
+def test_non_finite_value():
+    with pytest.raises(
+        stabdae.ModelError, match=r"forces\(t, q, v, p, out\) returned non-finite values .*\[\(1,\)\]"
+    ):  # fmt: skip
+        build(forces=forces_nan)
+
+
+def test_plain_python_function():
+    with pytest.raises(
+        stabdae.ModelError, match=r"forces must be an @njit function .*got a plain Python function"
+    ):  # fmt: skip
+        build(forces=forces_plain)
+
+
+def test_compile_failure_is_named():
+    with pytest.raises(stabdae.ModelError, match=r"forces\(t, q, v, p, out\) .*failed"):
+        build(forces=forces_bad_types)
+
+
+def test_missing_and_superfluous_pieces():
+    with pytest.raises(stabdae.ModelError, match=r"m=1 holonomic constraints need \['f_accel'\]"):
+        build(f_accel=None)
+    with pytest.raises(stabdae.ModelError, match=r"f is given but m=0"):
+        build(m=0, k=1)
+    with pytest.raises(stabdae.ModelError, match=r"k=1 nonholonomic constraints need \['h', 'h_q'"):
+        build(k=1)
+    with pytest.raises(stabdae.ModelError, match=r"forces\(t, q, v, p, out\) is required"):
+        build(forces=None)
+    with pytest.raises(stabdae.ModelError, match=r"at least one constraint"):
+        build(m=0, f=None, f_q=None, f_accel=None)
+    with pytest.raises(stabdae.ModelError, match=r"r = m \+ k = 3 constraints on n = 2"):
+        build(m=3)
+    with pytest.raises(stabdae.ModelError, match=r"m must be a non-negative integer, got 1.5"):
+        build(m=1.5)
+
+
+def test_reference_state_shape_and_consistency():
+    with pytest.raises(
+        stabdae.ModelError, match=r"reference_state must have shape \(2n,\) = \(4,\) for n=2, got \(3,\)"
+    ):  # fmt: skip
+        build(reference_state=np.zeros(3))
+    with pytest.raises(stabdae.ModelError, match=r"not on the constraint manifold.*'f_0'"):
+        build(reference_state=np.array([0.0, -1.1, 1.0, 0.0]))
+    with pytest.raises(stabdae.ModelError, match=r"not on the constraint manifold.*'fdot_0'"):
+        build(reference_state=np.array([0.0, -1.0, 0.0, 1.0]))
+
+
+def test_bad_energy_and_params():
+    with pytest.raises(stabdae.ModelError, match=r"energy\(t, q, v, p\) must return a float"):
+        build(energy=energy_array)
+    with pytest.raises(stabdae.ModelError, match=r"parameter 'g' must be finite"):
+        build(params={"g": np.inf})
+    with pytest.raises(stabdae.ModelError, match=r"coordinates must name the n=2 coordinates"):
+        build(coordinates=["x"])
+    model = build(params={"g": 9.81})
+    with pytest.raises(stabdae.ModelError, match=r"unknown parameter 'l'; known parameters: \['g'\]"):
+        model.param_vector({"l": 2.0})
+    with pytest.raises(stabdae.ModelError, match=r"parameter vector must have shape \(1,\)"):
+        model.param_vector(np.zeros(3))
+
+
+# ---------------------------------------------------------------- laws
+
+
+@njit
+def law_wrong_shape(t, x, p, out):
+    out[0, 0] = -1.0
+    out[0, 1] = -1.0
+    out[0, 2] = -1.0
+
+
+def law_plain(t, x, p, out):
+    out[:] = 0.0
+
+
+def test_law_errors():
+    model = build()
+    with pytest.raises(
+        stabdae.LawError, match=r"matrix: A must have shape \(r, m \+ r\) = \(1, 2\) .*got \(2, 3\)"
+    ):  # fmt: skip
+        stabdae.integrate(model, None, stabdae.matrix(np.zeros((2, 3))), "rk4", 0.1, 1.0)
+    with pytest.raises(stabdae.LawError, match=r"first block row \[0, I_1, 0\]"):
+        stabdae.matrix(np.array([[1.0, 0.0], [-1.0, -1.0]])).A(model)
+    with pytest.raises(stabdae.LawError, match=r"baumgarte: model 'broken' has m=1 .*give omega"):
+        stabdae.baumgarte(xi=1.0).A(model)
+    with pytest.raises(stabdae.LawError, match=r"baumgarte: omega must be positive"):
+        stabdae.baumgarte(omega=-1.0)
+    with pytest.raises(stabdae.LawError, match=r"theorem5: the law is for nonholonomic"):
+        stabdae.integrate(model, None, stabdae.theorem5(1.0), "rk4", 0.1, 1.0)
+    sleigh = load_scene("chaplygin_sleigh")
+    with pytest.raises(stabdae.LawError, match=r"theorem5: L must have shape \(k, k\) = \(1, 1\)"):
+        stabdae.integrate(sleigh, None, stabdae.theorem5(1.0, np.eye(2)), "rk4", 0.1, 1.0)
+    with pytest.raises(stabdae.LawError, match=r"theorem5: L must be symmetric positive definite"):
+        stabdae.integrate(sleigh, None, stabdae.theorem5(1.0, [[-1.0]]), "rk4", 0.1, 1.0)
+    with pytest.raises(stabdae.LawError, match=r"user law: .* must be an @njit function"):
+        stabdae.user(law_plain)
+    with pytest.raises(
+        stabdae.LawError, match=r"law_wrong_shape\(t, x, p, out\) writes outside out: expected "
+        r"shape \(1, 2\) .*got \(1, 3\)"
+    ):  # fmt: skip
+        stabdae.integrate(model, None, stabdae.user(law_wrong_shape), "rk4", 0.1, 1.0)
+
+
+# ---------------------------------------------------------------- schemes and integrate
+
+
+def test_scheme_errors():
+    with pytest.raises(stabdae.SchemeError, match=r"unknown scheme 'rk3'"):
+        stabdae.integrate(build(), None, stabdae.none(), "rk3", 0.1, 1.0)
+    with pytest.raises(stabdae.SchemeError, match=r"declared order 2 but .* up to order 1"):
+        stabdae.Scheme("bad", [[0, 0], [1, 0]], [1, 0], [0, 1], 2, {})
+    with pytest.raises(stabdae.SchemeError, match=r"weights must sum to 1"):
+        stabdae.Scheme("bad", [[0.0]], [0.5], [0.0], 1, {})
+    with pytest.raises(stabdae.SchemeError, match=r"rows of A must sum to c"):
+        stabdae.Scheme("bad", [[0, 0], [1, 0]], [0.5, 0.5], [0, 0.5], 1, {})
+    with pytest.raises(stabdae.SchemeError, match=r"strictly lower triangular"):
+        stabdae.Scheme("bad", [[1.0]], [1.0], [1.0], 1, {})
+
+
+def test_integrate_errors():
+    model = build()
+    law = stabdae.baumgarte(10.0)
+    with pytest.raises(ValueError, match=r"t_end - t0 = 1 must be a whole multiple of tau = 0.3"):
+        stabdae.integrate(model, None, law, "rk4", 0.3, 1.0)
+    with pytest.raises(ValueError, match=r"save_dt = 0.15 must be a whole multiple of tau = 0.1"):
+        stabdae.integrate(model, None, law, "rk4", 0.1, 1.0, 0.15)
+    with pytest.raises(ValueError, match=r"tau must be positive and finite, got -0.1"):
+        stabdae.integrate(model, None, law, "rk4", -0.1, 1.0)
+    with pytest.raises(ValueError, match=r"x0 must have shape \(2n,\) = \(4,\) .*got \(2,\)"):
+        stabdae.integrate(model, np.zeros(2), law, "rk4", 0.1, 1.0)
+    with pytest.raises(ValueError, match=r"x0 has non-finite entries"):
+        stabdae.integrate(model, np.full(4, np.nan), law, "rk4", 0.1, 1.0)
+    with pytest.raises(ValueError, match=r"give a law"):
+        stabdae.integrate(model, None, None, "rk4", 0.1, 1.0)
+    with pytest.raises(ValueError, match=r"t_end must be after t0"):
+        stabdae.integrate(model, None, law, "rk4", 0.1, 0.0)

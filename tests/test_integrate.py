@@ -1,0 +1,206 @@
+"""integrate(): the dataset, failures reported as statuses, and what the kernels compile."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+import xarray as xr
+from numba import njit
+
+import stabdae
+from stabdae._dataset import write_netcdf
+from stabdae._integrate import integrator_for
+from stabdae._laws import bind_law
+from stabdae._rhs import kernels_for
+from conftest import load_scene, perturbed_state
+
+
+def test_dataset_schema_and_units():
+    model = load_scene("double_pendulum")
+    ds = stabdae.integrate(model, perturbed_state(model, 1e-3), stabdae.baumgarte(10.0), "heun",
+                           1e-3, 0.5, 0.05)  # fmt: skip
+    assert ds.sizes == {"time": 11, "state": 8, "component": 4}
+    np.testing.assert_allclose(ds.time.values, np.arange(11) * 0.05, atol=1e-15)
+    for name, var in {**ds.data_vars, **ds.coords}.items():
+        assert var.attrs.get("long_name"), name
+        assert var.attrs.get("units"), name
+    assert list(ds.component.values) == ["f_0", "f_1", "fdot_0", "fdot_1"]
+    assert list(ds.state_units.values[:2]) == ["m", "m"] and ds.state_units.values[4] == "m s-1"
+    np.testing.assert_allclose(ds.residual_norm, np.abs(ds.residual).max("component"))
+    attrs = ds.attrs
+    assert attrs["Conventions"] == "CF-1.10"
+    assert attrs["model"] == "double_pendulum" and attrs["law"] == "baumgarte"
+    assert attrs["law_omega"] == 10.0 and attrs["scheme"] == "heun" and attrs["tau"] == 1e-3
+    assert attrs["model_param_g"] == 9.81 and attrs["status"] == 0
+    # the stored residual is g(x) of the stored state
+    for i in (0, 5, 10):
+        np.testing.assert_allclose(
+            ds.residual.values[i], model.residual(ds.x.values[i]), rtol=1e-12, atol=1e-15
+        )
+
+
+def test_netcdf_round_trip(tmp_path):
+    model = load_scene("chaplygin_sleigh")
+    ds = stabdae.integrate(model, perturbed_state(model, 1e-3), stabdae.theorem5(2.0), "rk4",
+                           1e-3, 0.5, 0.01)  # fmt: skip
+    path = write_netcdf(ds, tmp_path / "sub" / "sleigh.nc")
+    assert sorted(p.name for p in path.parent.iterdir()) == ["sleigh.nc"]  # no temporary left
+    with xr.open_dataset(path) as back:
+        xr.testing.assert_identical(back.load(), ds)
+    with pytest.raises(FileExistsError, match="exists"):
+        write_netcdf(ds, path, overwrite=False)
+
+
+def test_params_change_without_recompiling():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    a = stabdae.integrate(model, None, law, "rk4", 1e-3, 0.5, 0.5, params={"g": 9.81, "l": 1.0})
+    kernel = integrator_for(model, bind_law(law, model))
+    before = len(kernel.signatures)
+    b = stabdae.integrate(model, model.reference_state(model.param_vector({"l": 2.0})),
+                          stabdae.baumgarte(3.0, 0.5), "euler", 1e-3, 0.5, 0.5,
+                          params={"l": 2.0})  # fmt: skip
+    assert len(kernel.signatures) == before
+    # a longer pendulum swings more slowly: the states differ
+    assert not np.allclose(a.x.values[-1], b.x.values[-1])
+    assert abs(np.hypot(*b.x.values[-1, :2]) - 2.0) < 1e-3
+
+
+# ---------------------------------------------------------------- failures are statuses
+
+
+@njit
+def forces(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = 9.81
+
+
+@njit
+def f_twice(t, q, p, out):
+    r = q[0] * q[0] + q[1] * q[1] - 1.0
+    out[0] = r
+    out[1] = 2.0 * r  # the same constraint again: F has rank 1, S is singular
+
+
+@njit
+def f_q_twice(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+    out[1, 0] = 4.0 * q[0]
+    out[1, 1] = 4.0 * q[1]
+
+
+@njit
+def f_accel_twice(t, q, v, p, out):
+    s = 2.0 * (v[0] * v[0] + v[1] * v[1])
+    out[0] = s
+    out[1] = 2.0 * s
+
+
+@njit
+def f(t, q, p, out):
+    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
+
+
+@njit
+def f_q(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+
+
+@njit
+def f_accel(t, q, v, p, out):
+    out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
+
+
+@njit
+def mass_param(t, q, p, out):
+    out[0, 0] = 1.0
+    out[0, 1] = 0.0
+    out[1, 0] = 0.0
+    out[1, 1] = p[0]
+
+
+@njit
+def mass_identity(t, q, p, out):
+    out[0, 0] = 1.0
+    out[0, 1] = 0.0
+    out[1, 0] = 0.0
+    out[1, 1] = 1.0
+
+
+X_REF = np.array([0.0, -1.0, 1.0, 0.0])
+
+
+def test_singular_S_is_a_status_not_nan():
+    model = stabdae.Model("redundant", 2, 2, reference_state=X_REF, forces=forces, f=f_twice,
+                          f_q=f_q_twice, f_accel=f_accel_twice)  # fmt: skip
+    with pytest.warns(stabdae.IntegrationWarning, match=r"stopped at step 0 .*singular constraint"):
+        ds = stabdae.integrate(model, None, stabdae.baumgarte(10.0), "rk4", 0.01, 1.0, 0.1)
+    assert ds.attrs["status"] == stabdae.Status.SINGULAR_S
+    assert ds.attrs["status_name"] == "singular_s"
+    np.testing.assert_array_equal(ds.x.values[0], X_REF)  # the initial sample is kept
+    assert np.isnan(ds.x.values[1:]).all()
+
+
+def test_mass_not_spd_is_a_status():
+    model = stabdae.Model("negative_mass", 2, 1, params={"m2": 1.0}, reference_state=X_REF,
+                          mass=mass_param, forces=forces, f=f, f_q=f_q, f_accel=f_accel)  # fmt: skip
+    with pytest.warns(stabdae.IntegrationWarning, match="mass matrix is not symmetric positive"):
+        ds = stabdae.integrate(model, None, stabdae.baumgarte(10.0), "rk4", 0.01, 1.0,
+                               params={"m2": -1.0})  # fmt: skip
+    assert ds.attrs["status"] == stabdae.Status.MASS_NOT_SPD
+
+
+def test_blow_up_stops_with_a_status_and_keeps_the_finite_part():
+    """Euler far outside its stability region (τω = 10 > 2ξ) grows until it overflows."""
+    model = load_scene("pendulum")
+    x0 = perturbed_state(model, 1e-3)
+    with pytest.warns(stabdae.IntegrationWarning, match=r"stopped at step \d+"):
+        ds = stabdae.integrate(model, x0, stabdae.baumgarte(100.0), "euler", 0.1, 100.0)
+    assert ds.attrs["status"] in (stabdae.Status.NONFINITE_STATE, stabdae.Status.SINGULAR_S)
+    done = ds.attrs["steps_completed"]
+    assert 0 < done < 1000
+    assert np.isfinite(ds.x.values[: done + 1]).all() and np.isnan(ds.x.values[done + 1 :]).all()
+
+
+# ---------------------------------------------------------------- what the kernels compile
+
+
+def _sqrt_calls(model) -> int:
+    rhs = kernels_for(model, bind_law(stabdae.baumgarte(10.0), model)).rhs
+    stabdae.integrate(model, None, stabdae.baumgarte(10.0), "euler", 0.1, 0.1)  # compile
+    ir = next(iter(rhs.inspect_llvm().values()))
+    return len(re.findall(r"call (?:fast )?double @(?:llvm\.)?sqrt(?:\.f64)?\(", ir))
+
+
+def test_identity_mass_compiles_no_factorization():
+    """One square root (the 1×1 Cholesky of S) without a mass matrix; with an explicit
+    2×2 identity the mass factorization adds two."""
+    plain = stabdae.Model("no_mass", 2, 1, reference_state=X_REF, forces=forces, f=f, f_q=f_q,
+                          f_accel=f_accel)  # fmt: skip
+    explicit = stabdae.Model("with_mass", 2, 1, reference_state=X_REF, mass=mass_identity,
+                             forces=forces, f=f, f_q=f_q, f_accel=f_accel)  # fmt: skip
+    assert _sqrt_calls(plain) == 1
+    assert _sqrt_calls(explicit) == 3
+
+
+def test_step_loop_allocates_nothing():
+    """NRT allocation count is the same for 10 and 10 000 steps: the loop allocates nothing."""
+    from numba.core.runtime import _nrt_python, rtsys
+
+    model = load_scene("double_pendulum")
+    law = stabdae.baumgarte(10.0)
+    stabdae.integrate(model, None, law, "rk4", 1e-3, 0.01)  # compile
+    _nrt_python.memsys_enable_stats()
+    try:
+        counts = []
+        for t_end in (0.01, 10.0):
+            before = rtsys.get_allocation_stats().alloc
+            stabdae.integrate(model, None, law, "rk4", 1e-3, t_end, t_end)
+            counts.append(rtsys.get_allocation_stats().alloc - before)
+    finally:
+        _nrt_python.memsys_disable_stats()
+    assert counts[0] == counts[1] and counts[0] > 0
