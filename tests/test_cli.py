@@ -7,8 +7,8 @@ import sys
 
 import xarray as xr
 
-from stabdae._cli import main
 from conftest import KERNELS, ROOT
+from stabdae._cli import main
 
 
 def test_check_passes_on_a_scene(capsys):

@@ -130,8 +130,9 @@ def test_counts_disagree_with_functions():
 
 def test_non_finite_value():
     with pytest.raises(
-        stabdae.ModelError, match=r"forces\(t, q, v, p, out\) returned non-finite values .*\[\(1,\)\]"
-    ):  # fmt: skip
+        stabdae.ModelError,
+        match=r"forces\(t, q, v, p, out\) returned non-finite values .*\[\(1,\)\]",
+    ):
         build(forces=forces_nan)
 
 
@@ -166,8 +167,9 @@ def test_missing_and_superfluous_pieces():
 
 def test_reference_state_shape_and_consistency():
     with pytest.raises(
-        stabdae.ModelError, match=r"reference_state must have shape \(2n,\) = \(4,\) for n=2, got \(3,\)"
-    ):  # fmt: skip
+        stabdae.ModelError,
+        match=r"reference_state must have shape \(2n,\) = \(4,\) for n=2, got \(3,\)",
+    ):
         build(reference_state=np.zeros(3))
     with pytest.raises(stabdae.ModelError, match=r"not on the constraint manifold.*'f_0'"):
         build(reference_state=np.array([0.0, -1.1, 1.0, 0.0]))
@@ -183,7 +185,7 @@ def test_bad_energy_and_params():
     with pytest.raises(stabdae.ModelError, match=r"coordinates must name the n=2 coordinates"):
         build(coordinates=["x"])
     model = build(params={"g": 9.81})
-    with pytest.raises(stabdae.ModelError, match=r"unknown parameter 'l'; known parameters: \['g'\]"):
+    with pytest.raises(stabdae.ModelError, match=r"unknown parameter 'l'; known .*\['g'\]"):
         model.param_vector({"l": 2.0})
     with pytest.raises(stabdae.ModelError, match=r"parameter vector must have shape \(1,\)"):
         model.param_vector(np.zeros(3))

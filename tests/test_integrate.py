@@ -10,11 +10,11 @@ import xarray as xr
 from numba import njit
 
 import stabdae
+from conftest import load_scene, perturbed_state
 from stabdae._dataset import write_netcdf
 from stabdae._integrate import integrator_for
 from stabdae._laws import bind_law
 from stabdae._rhs import kernels_for
-from conftest import load_scene, perturbed_state
 
 
 def test_dataset_schema_and_units():
@@ -147,7 +147,8 @@ def test_singular_S_is_a_status_not_nan():
 
 def test_mass_not_spd_is_a_status():
     model = stabdae.Model("negative_mass", 2, 1, params={"m2": 1.0}, reference_state=X_REF,
-                          mass=mass_param, forces=forces, f=f, f_q=f_q, f_accel=f_accel)  # fmt: skip
+                          mass=mass_param, forces=forces, f=f, f_q=f_q,
+                          f_accel=f_accel)  # fmt: skip
     with pytest.warns(stabdae.IntegrationWarning, match="mass matrix is not symmetric positive"):
         ds = stabdae.integrate(model, None, stabdae.baumgarte(10.0), "rk4", 0.01, 1.0,
                                params={"m2": -1.0})  # fmt: skip

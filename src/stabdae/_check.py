@@ -137,47 +137,52 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
         xs.append(x_ref + radius * scale * rng.standard_normal(x_ref.shape))
         ts.append(model.t0 + (rng.uniform(0.0, 1.0) if model.time_dependent else 0.0))
     report = CheckReport(model.name, rtol, np.array(xs))
-    n = model.n
+    for i, (x, t) in enumerate(zip(xs, ts)):
+        _check_state(model, report, i, x, t, p)
+    return report
 
-    def add(piece, i, analytic, fd, detail=""):
+
+def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> None:
+    """Append the rows of state ``i`` to ``report``."""
+    n, ev = model.n, model.evaluate
+    q, v = x[:n], x[n:]
+
+    def add(piece, analytic, fd, detail=""):
         analytic, fd = np.asarray(analytic), np.asarray(fd)
         err = float(np.max(np.abs(analytic - fd))) if analytic.size else 0.0
         mag = max(1.0, float(np.max(np.abs(fd), initial=0.0)),
                   float(np.max(np.abs(analytic), initial=0.0)))  # fmt: skip
-        report.rows.append(CheckRow(piece, i, err, rtol * mag, detail))
+        report.rows.append(CheckRow(piece, i, err, report.rtol * mag, detail))
 
-    for i, (x, t) in enumerate(zip(xs, ts)):
-        q, v = x[:n], x[n:]
-        ev = model.evaluate
-        if model.m:
-            add("f_q", i, ev("f_q", t, x, p),
-                _jacobian(lambda qq: ev("f", t, np.concatenate([qq, v]), p), q))  # fmt: skip
-            add("f_t", i, ev("f_t", t, x, p),
-                _scalar_derivative(lambda s: ev("f", s, x, p), t),
-                "" if "f_t" in model.functions else "model declares none")  # fmt: skip
+    def with_q(qq):
+        return np.concatenate([qq, v])
 
-            def fdot(s, x=x, t=t):
-                xx = np.concatenate([q + (s - t) * v, v])
-                return ev("f_q", s, xx, p) @ v + ev("f_t", s, xx, p)
+    def with_v(vv):
+        return np.concatenate([q, vv])
 
-            add("f_accel", i, ev("f_accel", t, x, p), _scalar_derivative(fdot, t))
-        if model.k:
-            add("h_q", i, ev("h_q", t, x, p),
-                _jacobian(lambda qq: ev("h", t, np.concatenate([qq, v]), p), q))  # fmt: skip
-            add("h_v", i, ev("h_v", t, x, p),
-                _jacobian(lambda vv: ev("h", t, np.concatenate([q, vv]), p), v))  # fmt: skip
-            add("h_t", i, ev("h_t", t, x, p),
-                _scalar_derivative(lambda s: ev("h", s, x, p), t),
-                "" if "h_t" in model.functions else "model declares none")  # fmt: skip
-        if model.has_mass:
-            M = ev("mass", t, x, p)
-            asym = float(np.max(np.abs(M - M.T)))
-            mag = max(1.0, float(np.max(np.abs(M))))
-            report.rows.append(CheckRow("mass", i, asym, 1e-12 * mag, "symmetry"))
-            lam_min = float(np.linalg.eigvalsh(0.5 * (M + M.T)).min())
-            report.rows.append(
-                CheckRow("mass", i, 0.0 if lam_min > 0 else 1.0, 0.0,
-                         f"smallest eigenvalue {lam_min:.3e}: "
-                         + ("positive definite" if lam_min > 0 else "NOT positive definite"))
-            )  # fmt: skip
-    return report
+    if model.m:
+        add("f_q", ev("f_q", t, x, p), _jacobian(lambda qq: ev("f", t, with_q(qq), p), q))
+        add("f_t", ev("f_t", t, x, p), _scalar_derivative(lambda s: ev("f", s, x, p), t),
+            "" if "f_t" in model.functions else "model declares none")  # fmt: skip
+
+        def fdot(s):  # ḟ along the motion q(s) = q + (s − t) v
+            xx = np.concatenate([q + (s - t) * v, v])
+            return ev("f_q", s, xx, p) @ v + ev("f_t", s, xx, p)
+
+        add("f_accel", ev("f_accel", t, x, p), _scalar_derivative(fdot, t))
+    if model.k:
+        add("h_q", ev("h_q", t, x, p), _jacobian(lambda qq: ev("h", t, with_q(qq), p), q))
+        add("h_v", ev("h_v", t, x, p), _jacobian(lambda vv: ev("h", t, with_v(vv), p), v))
+        add("h_t", ev("h_t", t, x, p), _scalar_derivative(lambda s: ev("h", s, x, p), t),
+            "" if "h_t" in model.functions else "model declares none")  # fmt: skip
+    if model.has_mass:
+        M = ev("mass", t, x, p)
+        asym = float(np.max(np.abs(M - M.T)))
+        mag = max(1.0, float(np.max(np.abs(M))))
+        report.rows.append(CheckRow("mass", i, asym, 1e-12 * mag, "symmetry"))
+        lam_min = float(np.linalg.eigvalsh(0.5 * (M + M.T)).min())
+        verdict = "positive definite" if lam_min > 0 else "NOT positive definite"
+        report.rows.append(
+            CheckRow("mass", i, 0.0 if lam_min > 0 else 1.0, 0.0,
+                     f"smallest eigenvalue {lam_min:.3e}: {verdict}")
+        )  # fmt: skip

@@ -149,7 +149,9 @@ def two_stage(a: float, sigma: float, *, name: str | None = None) -> Scheme:
     try:
         a, sigma = float(a), float(sigma)
     except (TypeError, ValueError):
-        raise SchemeError(f"two_stage: a and sigma must be real numbers, got {a!r}, {sigma!r}")
+        raise SchemeError(
+            f"two_stage: a and sigma must be real numbers, got {a!r}, {sigma!r}"
+        ) from None
     if not (math.isfinite(a) and math.isfinite(sigma)):
         raise SchemeError(f"two_stage: a and sigma must be finite, got a={a}, sigma={sigma}")
     if sigma != 0.0 and a == 0.0:
