@@ -8,6 +8,7 @@ from numba import njit
 
 import stabdae
 from conftest import SCENES, load_scene
+from toy import X_REF, unit_pendulum
 
 KNIFE = load_scene("knife_edge")
 
@@ -20,21 +21,7 @@ def test_scenes_pass_check(name):
         load_scene(name).functions else {"h_q", "h_v"})  # fmt: skip
 
 
-@njit
-def forces(t, q, v, p, out):
-    out[0] = 0.0
-    out[1] = 9.81
 
-
-@njit
-def f(t, q, p, out):
-    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
-
-
-@njit
-def f_q(t, q, p, out):
-    out[0, 0] = 2.0 * q[0]
-    out[0, 1] = 2.0 * q[1]
 
 
 @njit
@@ -42,10 +29,6 @@ def f_q_wrong(t, q, p, out):
     out[0, 0] = 2.0 * q[0]
     out[0, 1] = q[1]  # should be 2 y
 
-
-@njit
-def f_accel(t, q, v, p, out):
-    out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
 
 
 @njit
@@ -74,13 +57,10 @@ def mass_asymmetric(t, q, p, out):
     out[1, 1] = 1.0
 
 
-X_REF = np.array([0.0, -1.0, 1.0, 0.0])
 
 
 def pendulum(**overrides):
-    kwargs = dict(n=2, m=1, reference_state=X_REF, forces=forces, f=f, f_q=f_q, f_accel=f_accel)
-    kwargs.update(overrides)
-    return stabdae.Model("test_pendulum", **kwargs)
+    return unit_pendulum("test_pendulum", **overrides)
 
 
 def test_check_names_wrong_f_q():

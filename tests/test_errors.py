@@ -8,30 +8,13 @@ from numba import njit
 
 import stabdae
 from conftest import load_scene
+from toy import unit_pendulum
 
 # ---------------------------------------------------------------- a pendulum to break
 
 
-@njit
-def forces(t, q, v, p, out):
-    out[0] = 0.0
-    out[1] = 9.81
 
 
-@njit
-def f(t, q, p, out):
-    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
-
-
-@njit
-def f_q(t, q, p, out):
-    out[0, 0] = 2.0 * q[0]
-    out[0, 1] = 2.0 * q[1]
-
-
-@njit
-def f_accel(t, q, v, p, out):
-    out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
 
 
 @njit
@@ -81,15 +64,10 @@ def forces_plain(t, q, v, p, out):
     out[1] = 9.81
 
 
-X_REF = np.array([0.0, -1.0, 1.0, 0.0])
 
 
 def build(**overrides):
-    kwargs = dict(
-        n=2, m=1, reference_state=X_REF, forces=forces, f=f, f_q=f_q, f_accel=f_accel
-    )
-    kwargs.update(overrides)
-    return stabdae.Model("broken", **kwargs)
+    return unit_pendulum("broken", **overrides)
 
 
 def test_valid_model_builds():

@@ -15,6 +15,7 @@ from stabdae._dataset import write_netcdf
 from stabdae._integrate import integrator_for
 from stabdae._laws import bind_law
 from stabdae._rhs import kernels_for
+from toy import X_REF, unit_pendulum
 
 
 def test_dataset_schema_and_units():
@@ -71,11 +72,6 @@ def test_params_change_without_recompiling():
 # ---------------------------------------------------------------- failures are statuses
 
 
-@njit
-def forces(t, q, v, p, out):
-    out[0] = 0.0
-    out[1] = 9.81
-
 
 @njit
 def f_twice(t, q, p, out):
@@ -99,20 +95,7 @@ def f_accel_twice(t, q, v, p, out):
     out[1] = 2.0 * s
 
 
-@njit
-def f(t, q, p, out):
-    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
 
-
-@njit
-def f_q(t, q, p, out):
-    out[0, 0] = 2.0 * q[0]
-    out[0, 1] = 2.0 * q[1]
-
-
-@njit
-def f_accel(t, q, v, p, out):
-    out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
 
 
 @njit
@@ -131,12 +114,10 @@ def mass_identity(t, q, p, out):
     out[1, 1] = 1.0
 
 
-X_REF = np.array([0.0, -1.0, 1.0, 0.0])
 
 
 def test_singular_S_is_a_status_not_nan():
-    model = stabdae.Model("redundant", 2, 2, reference_state=X_REF, forces=forces, f=f_twice,
-                          f_q=f_q_twice, f_accel=f_accel_twice)  # fmt: skip
+    model = unit_pendulum("redundant", m=2, f=f_twice, f_q=f_q_twice, f_accel=f_accel_twice)
     with pytest.warns(stabdae.IntegrationWarning, match=r"stopped at step 0 .*singular constraint"):
         ds = stabdae.integrate(model, None, stabdae.baumgarte(10.0), "rk4", 0.01, 1.0, 0.1)
     assert ds.attrs["status"] == stabdae.Status.SINGULAR_S
@@ -146,9 +127,7 @@ def test_singular_S_is_a_status_not_nan():
 
 
 def test_mass_not_spd_is_a_status():
-    model = stabdae.Model("negative_mass", 2, 1, params={"m2": 1.0}, reference_state=X_REF,
-                          mass=mass_param, forces=forces, f=f, f_q=f_q,
-                          f_accel=f_accel)  # fmt: skip
+    model = unit_pendulum("negative_mass", params={"m2": 1.0}, mass=mass_param)
     with pytest.warns(stabdae.IntegrationWarning, match="mass matrix is not symmetric positive"):
         ds = stabdae.integrate(model, None, stabdae.baumgarte(10.0), "rk4", 0.01, 1.0,
                                params={"m2": -1.0})  # fmt: skip
@@ -180,10 +159,8 @@ def _sqrt_calls(model) -> int:
 def test_identity_mass_compiles_no_factorization():
     """One square root (the 1×1 Cholesky of S) without a mass matrix; with an explicit
     2×2 identity the mass factorization adds two."""
-    plain = stabdae.Model("no_mass", 2, 1, reference_state=X_REF, forces=forces, f=f, f_q=f_q,
-                          f_accel=f_accel)  # fmt: skip
-    explicit = stabdae.Model("with_mass", 2, 1, reference_state=X_REF, mass=mass_identity,
-                             forces=forces, f=f, f_q=f_q, f_accel=f_accel)  # fmt: skip
+    plain = unit_pendulum("no_mass")
+    explicit = unit_pendulum("with_mass", mass=mass_identity)
     assert _sqrt_calls(plain) == 1
     assert _sqrt_calls(explicit) == 3
 
