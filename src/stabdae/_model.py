@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from numba.core.dispatcher import Dispatcher
@@ -55,12 +54,6 @@ _REQUIRED_IF_K = ("h", "h_q", "h_v")
 # Marks output entries a function did not write.  Arithmetic on model data does not land
 # on this exact value, and unlike NaN it cannot be confused with a computed non-finite.
 _UNWRITTEN = -7.0e307
-
-
-@dataclass(frozen=True)
-class _Piece:
-    name: str
-    fn: Dispatcher
 
 
 class Model:

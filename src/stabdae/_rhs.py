@@ -77,6 +77,10 @@ def kernels_for(model: Model, bound: BoundLaw) -> Kernels:
 
 
 def _build(model: Model, law_code: int, law_fn) -> Kernels:
+    # No cache=True on these closures: numba keys a closure's cache entry on a pickle of
+    # the captured dispatchers, which carries a per-process id, so the on-disk cache would
+    # never hit (seen with numba 0.68: a new cache file on every run).  The library's own
+    # self-contained kernels (_linalg) are cached.
     # Compile-time constants of the closure.
     n, m, k = model.n, model.m, model.k
     r, ng = m + k, 2 * m + k
