@@ -4,6 +4,7 @@ numerical integration, after R. G. Mukharlyamov's constraint-perturbation equati
 The public API is exactly what this module re-exports.
 """
 
+from ._ensemble import ensemble, sample_perturbations
 from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, baumgarte, matrix, none, theorem5, user
 from ._loading import load_model, scene_names
@@ -23,6 +24,7 @@ __all__ = [
     "Status",
     "__version__",
     "baumgarte",
+    "ensemble",
     "euler",
     "heun",
     "integrate",
@@ -31,6 +33,7 @@ __all__ = [
     "midpoint",
     "none",
     "rk4",
+    "sample_perturbations",
     "scene_names",
     "theorem5",
     "two_stage",

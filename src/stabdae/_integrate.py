@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections import namedtuple
 
 import numpy as np
 import xarray as xr
@@ -25,16 +26,25 @@ class IntegrationWarning(RuntimeWarning):
     """An integration stopped early; the dataset holds everything up to that step."""
 
 
-def integrator_for(model: Model, bound):
-    """The compiled single-trajectory loop for ``model`` under the law's kind (memoized)."""
-    key = ("integrate", bound.code, bound.fn)
+Stepper = namedtuple("Stepper", "step integrate")
+
+
+def stepper_for(model: Model, bound) -> Stepper:
+    """The compiled RK step and single-trajectory loop for ``model`` under the law's kind
+    (memoized on the model)."""
+    key = ("stepper", bound.code, bound.fn)
     cache = model._kernel_cache
     if key not in cache:
-        cache[key] = _build_integrator(kernels_for(model, bound))
+        cache[key] = _build_stepper(kernels_for(model, bound))
     return cache[key]
 
 
-def _build_integrator(K):
+def integrator_for(model: Model, bound):
+    """The compiled single-trajectory loop for ``model`` under the law's kind."""
+    return stepper_for(model, bound).integrate
+
+
+def _build_stepper(K):
     rhs, residual, energy, make_workspace = K.rhs, K.residual, K.energy, K.make_workspace
     N2, ng = 2 * K.n, K.ng
 
@@ -98,7 +108,7 @@ def _build_integrator(K):
                 j += 1
         return 0, nsteps
 
-    return integrate_kernel
+    return Stepper(step, integrate_kernel)
 
 
 def _positive(value, name: str) -> float:

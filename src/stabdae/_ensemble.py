@@ -1,0 +1,382 @@
+"""Ensembles: many initial constraint perturbations of one model, integrated in parallel.
+
+Layering (STYLE: driver over kernel):
+
+* :func:`ensemble` validates, samples the perturbations (:mod:`._sampling`), calls the
+  compiled kernel, fits decay rates (:mod:`._estimate`) and builds the dataset;
+* the kernel integrates blocks of members in parallel (``prange`` over blocks); each
+  member's whole integration runs inside one compiled loop, with every buffer allocated
+  once per block.  Members never interact, so the results are bit-for-bit the same for
+  any thread count and any block size, and a member that diverges (non-finite state,
+  residual above the divergence threshold, singular ``S``) is frozen and flagged without
+  touching the others.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections import namedtuple
+
+import numpy as np
+import xarray as xr
+from numba import njit, prange
+
+from ._dataset import provenance, variable
+from ._estimate import FLOOR_MARGIN, fit_decay
+from ._integrate import _positive, _whole_multiple, stepper_for
+from ._laws import as_law, bind_law
+from ._model import Model
+from ._rhs import kernels_for
+from ._sampling import SAMPLING_RTOL, build_sampler, draw_alphas
+from ._schemes import as_scheme
+from ._status import Status, status_flag_attrs
+
+__all__ = ["ensemble", "sample_perturbations"]
+
+_DIVERGED = int(Status.DIVERGED)
+EnsembleKernels = namedtuple("EnsembleKernels", "sample integrate")
+
+
+def ensemble_kernels_for(model: Model, bound) -> EnsembleKernels:
+    key = ("ensemble", bound.code, bound.fn)
+    cache = model._kernel_cache
+    if key not in cache:
+        K = kernels_for(model, bound)
+        cache[key] = EnsembleKernels(
+            build_sampler(K), _build_ensemble_kernel(K, stepper_for(model, bound).step)
+        )
+    return cache[key]
+
+
+def _build_ensemble_kernel(K, step):
+    residual, energy, make_workspace = K.residual, K.energy, K.make_workspace
+    N2, ng = 2 * K.n, K.ng
+
+    @njit(parallel=True)
+    def ensemble_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal,
+                        tab_a, tab_b, tab_c, threshold, block,
+                        out_norm, x_final, status, fail_step, e0, e1):  # fmt: skip
+        """Integrate every row of ``x0s``; see :func:`ensemble` for the outputs.
+
+        ``out_norm`` must be pre-filled (NaN): samples after a failure are not written.
+        """
+        M = x0s.shape[0]
+        nblocks = (M + block - 1) // block
+        for b in prange(nblocks):
+            ws = make_workspace()
+            stages = np.empty((tab_b.shape[0], N2))
+            xs = np.empty(N2)
+            g = np.empty(ng)
+            x = np.empty(N2)
+            for j in range(b * block, min(M, (b + 1) * block)):
+                for l in range(N2):
+                    x[l] = x0s[j, l]
+                e0[j] = energy(t0, x, p, ws)
+                st = 0
+                failed_at = -1
+                k = 0
+                t = t0
+                for i in range(nsteps + 1):
+                    if i > 0:
+                        st = step(x, t, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c,
+                                  ws, stages, xs)  # fmt: skip
+                        if st != 0:
+                            failed_at = i - 1
+                            break
+                        t = t0 + i * tau
+                    if i % save_every == 0:
+                        residual(t, x, p, ws, g)
+                        nrm = 0.0
+                        for l in range(ng):
+                            nrm = max(nrm, abs(g[l]))
+                        out_norm[j, k] = nrm
+                        k += 1
+                        if not (nrm <= threshold):
+                            st = _DIVERGED
+                            failed_at = i
+                            break
+                status[j] = st
+                fail_step[j] = failed_at
+                for l in range(N2):
+                    x_final[j, l] = x[l]
+                e1[j] = energy(t, x, p, ws)
+
+    return ensemble_kernel
+
+
+# --------------------------------------------------------------------- sampling
+def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0, *,
+                         params=None, t0=None):  # fmt: skip
+    """Initial states ``x⁰`` with prescribed constraint perturbations ``g(x⁰, t0) = α⁰``.
+
+    Parameters
+    ----------
+    members : int
+    radius : float or (low, high)
+        ``‖α⁰‖∞`` is log-uniform in ``[low, high]``; directions are uniform.
+    seed : int or numpy.random.Generator
+
+    Returns
+    -------
+    x0 : array (members, 2n)
+    alpha0 : array (members, 2m + k)
+        The achieved perturbation ``g(x⁰, t0)``.
+    status : array (members,) of int8
+        ``Status.SAMPLING_FAILED`` where Gauss–Newton did not reach ``α⁰`` to
+        ``1e-12·‖α⁰‖∞`` (or to roundoff, for tiny ``α⁰``).
+    """
+    p = model.param_vector(params)
+    t0 = model.t0 if t0 is None else float(t0)
+    low, high = _radius(radius)
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    targets = draw_alphas(model.n_residual, _count(members, "members"), (low, high), rng)
+    return _place(model, targets, p, t0)
+
+
+def _place(model, targets, p, t0):
+    from ._laws import none
+
+    sampler = ensemble_kernels_for(model, bind_law(none(), model)).sample
+    M = targets.shape[0]
+    x0 = np.empty((M, 2 * model.n))
+    alpha0 = np.empty_like(targets)
+    status = np.zeros(M, dtype=np.int8)
+    iters = np.zeros(M, dtype=np.int64)
+    sampler(model.reference_state(p), t0, p, targets, x0, alpha0, status, iters)
+    return x0, alpha0, status
+
+
+def _radius(radius) -> tuple[float, float]:
+    vals = np.atleast_1d(np.asarray(radius, dtype=np.float64))
+    if vals.shape not in ((1,), (2,)) or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
+        raise ValueError(
+            f"ensemble: radius must be a positive number or a pair (low, high) of positive "
+            f"numbers, got {radius!r}"
+        )
+    low, high = float(vals[0]), float(vals[-1])
+    if low > high:
+        raise ValueError(f"ensemble: radius low = {low:g} exceeds high = {high:g}")
+    return low, high
+
+
+def _count(value, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"ensemble: {name} must be a positive integer, got {value!r}")
+    return int(value)
+
+
+# --------------------------------------------------------------------- driver
+def ensemble(
+    model: Model,
+    law,
+    scheme="rk2",
+    tau: float = 1e-3,
+    t_end: float = 1.0,
+    *,
+    members: int = 1024,
+    radius=(1e-6, 1e-2),
+    seed: int = 0,
+    save_dt: float | None = None,
+    x0=None,
+    params=None,
+    epsilon: float | None = None,
+    divergence: float | None = None,
+    block: int = 64,
+) -> xr.Dataset:
+    """Integrate an ensemble of initial constraint perturbations in parallel.
+
+    Parameters
+    ----------
+    model : Model
+    law : Law or @njit function
+    scheme : Scheme or str, default "rk2" (the midpoint rule)
+    tau, t_end, save_dt : float
+        Fixed step, final time, spacing of stored residual norms (as in :func:`integrate`;
+        default ``save_dt``: about 200 samples).
+    members : int
+        Ensemble size (ignored when ``x0`` is given).
+    radius : float or (low, high)
+        Range of ``‖α⁰‖∞``, log-uniform (DESIGN §6).
+    seed : int
+        Seed of the ``numpy.random.Generator`` that draws the perturbations.
+    x0 : array (members, 2n), optional
+        The user's own initial states instead of sampled ones.
+    params : mapping or array, optional
+        Physical parameters.
+    epsilon : float, optional
+        The ε of Definition 2: a member is *bounded* when ``max_t ‖g‖ ≤ ε`` and it decayed
+        (ended below ``max(‖α⁰‖, 10 × the ensemble's median floor)``).  Default
+        ``10 × radius high``.
+    divergence : float, optional
+        Residual norm above which a member is frozen and flagged ``diverged``
+        (default ``1e3 × epsilon``).
+    block : int
+        Members per parallel work item.  Does not change any number.
+
+    Returns
+    -------
+    xarray.Dataset
+        See ``docs/api.md``: ``residual_norm(member, time)`` (float32), ``alpha0``, ``x0``,
+        ``x_final``, ``beta``, ``gamma``, ``residual_floor``, ``bounded``, ``diverged`` and
+        ``diverged_step``, ``energy_drift``, ``status`` per member; ``fraction_bounded``,
+        ``stability_radius``, ``beta_median`` and, for constant laws, ``beta_theory``,
+        ``beta_theory_discrete``, ``spectral_radius``.
+    """
+    if not isinstance(model, Model):
+        raise TypeError(f"ensemble: model must be a stabdae.Model, got {type(model).__name__}")
+    law = as_law(law)
+    scheme = as_scheme(scheme)
+    p = model.param_vector(params)
+    t0 = model.t0
+    tau = _positive(tau, "tau")
+    span = float(t_end) - t0
+    if not (math.isfinite(span) and span > 0):
+        raise ValueError(f"ensemble: t_end must be after t0 = {t0}, got t_end = {t_end!r}")
+    nsteps = _whole_multiple(span, tau, "t_end - t0", "tau")
+    if save_dt is None:
+        save_every = max(1, nsteps // 200)
+        while nsteps % save_every:
+            save_every -= 1
+    else:
+        save_every = _whole_multiple(_positive(save_dt, "save_dt"), tau, "save_dt", "tau")
+        if nsteps % save_every:
+            raise ValueError(
+                f"ensemble: t_end - t0 = {span:g} must be a whole multiple of save_dt = {save_dt:g}"
+            )
+    block = _count(block, "block")
+    low, high = _radius(radius)
+    epsilon = 10.0 * high if epsilon is None else _positive(epsilon, "epsilon")
+    divergence = 1e3 * epsilon if divergence is None else _positive(divergence, "divergence")
+
+    bound = bind_law(law, model)
+    kernels = ensemble_kernels_for(model, bound)
+    if x0 is None:
+        x0, alpha0, status = sample_perturbations(
+            model, _count(members, "members"), (low, high), seed, params=p
+        )
+    else:
+        x0 = np.array(x0, dtype=np.float64)
+        if x0.ndim != 2 or x0.shape[1] != 2 * model.n:
+            raise ValueError(
+                f"ensemble: x0 must have shape (members, 2n) = (M, {2 * model.n}), got {x0.shape}"
+            )
+        alpha0 = np.stack([model.residual(x, t0, p) for x in x0])
+        status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
+        status = status.astype(np.int8)
+    M = x0.shape[0]
+
+    nsave = nsteps // save_every + 1
+    norms = np.full((M, nsave), np.nan, dtype=np.float32)
+    x_final = np.empty_like(x0)
+    run_status = np.zeros(M, dtype=np.int8)
+    fail_step = np.full(M, -1, dtype=np.int64)
+    e0 = np.full(M, np.nan)
+    e1 = np.full(M, np.nan)
+    kernels.integrate(
+        np.ascontiguousarray(x0), t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
+        scheme.A, scheme.b, scheme.c, divergence, block, norms, x_final, run_status,
+        fail_step, e0, e1,
+    )  # fmt: skip
+    status = np.where(status != 0, status, run_status).astype(np.int8)
+    times = t0 + tau * save_every * np.arange(nsave)
+    return _ensemble_dataset(
+        model, p, law, scheme, bound, times, x0, alpha0, norms, x_final, status, fail_step,
+        e0, e1, epsilon,
+        dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every, steps=nsteps,
+             members=M, seed=seed, radius_low=low, radius_high=high, epsilon=epsilon,
+             divergence=divergence, sampling_rtol=SAMPLING_RTOL,
+             threads=int(os.environ.get("NUMBA_NUM_THREADS", 0)) or None),
+    )  # fmt: skip
+
+
+def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_final,
+                      status, fail_step, e0, e1, epsilon, run):  # fmt: skip
+    ok = status == 0
+    finite = np.isfinite(norms)
+    nvalid = np.where(finite.all(axis=1), norms.shape[1], np.argmin(finite, axis=1))
+    beta, gamma, floor, _ = fit_decay(norms, times, nvalid)
+    alpha_norm = np.max(np.abs(alpha0), axis=1)
+    max_res = np.where(nvalid > 0, np.nanmax(np.where(finite, norms, -np.inf), axis=1), np.nan)
+    final = norms[np.arange(norms.shape[0]), np.maximum(nvalid - 1, 0)].astype(np.float64)
+    floor_ref = float(np.nanmedian(np.where(ok, floor, np.nan))) if ok.any() else np.nan
+    decayed = ok & (final <= np.maximum(alpha_norm, FLOOR_MARGIN / 3 * floor_ref))
+    bounded = ok & (max_res <= epsilon) & decayed
+    diverged = status == int(Status.DIVERGED)
+    diverged |= status == int(Status.NONFINITE_STATE)
+    diverged |= status == int(Status.SINGULAR_S)
+
+    coords = {
+        "member": variable("member", np.arange(x0.shape[0]), "ensemble member", "1"),
+        "time": variable("time", times, "time", "s"),
+        "state": variable("state", model.state_names, "state component x = (q, v)", "1"),
+        "component": variable(
+            "component", model.component_names, "residual component g = (f, fdot, h) (3.2)", "1"
+        ),
+        "state_units": variable("state", model.state_units, "units of each state component", "1"),
+    }
+    mixed = "mixed (see state_units)"
+    data = {
+        "residual_norm": variable(
+            ("member", "time"), norms, "max-norm of the constraint residual", "1",
+            comment="stored as float32; NaN after a member stopped",
+        ),  # fmt: skip
+        "alpha0": variable(("member", "component"), alpha0,
+                           "initial perturbation g(x0, t0) achieved", "1"),  # fmt: skip
+        "alpha0_norm": variable("member", alpha_norm, "max-norm of alpha0", "1"),
+        "x0": variable(("member", "state"), x0, "initial state", mixed),
+        "x_final": variable(("member", "state"), x_final,
+                            "final state (last state before a stop)", mixed),  # fmt: skip
+        "beta": variable("member", beta, "fitted decay rate of the residual norm", "s-1",
+                         comment="fit on the transient above the floor, see stabdae._estimate"),  # fmt: skip
+        "gamma": variable("member", gamma, "prefactor: max over the transient of |g| exp(beta t)",
+                          "1"),  # fmt: skip
+        "residual_floor": variable("member", floor,
+                                   "residual level at the end (truncation floor)", "1"),  # fmt: skip
+        "max_residual": variable("member", max_res, "largest residual norm reached", "1"),
+        "bounded": variable("member", bounded.astype(np.int8),
+                            "stayed within epsilon and decayed (Definition 2)", "1",
+                            flag_values=[0, 1], flag_meanings="no yes"),  # fmt: skip
+        "diverged": variable("member", diverged.astype(np.int8), "stopped: blew up", "1",
+                             flag_values=[0, 1], flag_meanings="no yes"),  # fmt: skip
+        "diverged_step": variable("member", fail_step, "step at which the member stopped "
+                                  "(-1: ran to the end)", "1"),  # fmt: skip
+        "status": variable("member", status, "member status", "1", **status_flag_attrs()),
+        "fraction_bounded": variable((), float(bounded.mean()), "fraction of bounded members",
+                                     "1"),  # fmt: skip
+        "stability_radius": variable((), _stability_radius(alpha_norm, bounded),
+                                     "largest |alpha0| below which every member is bounded",
+                                     "1"),  # fmt: skip
+        "beta_median": variable((), float(np.nanmedian(beta)) if np.isfinite(beta).any()
+                                else np.nan, "median fitted decay rate", "s-1"),  # fmt: skip
+    }
+    if model.energy is not None:
+        data["energy_drift"] = variable("member", e1 - e0, "energy change E(final) - E(x0)",
+                                        "model units")  # fmt: skip
+    if law.is_constant:
+        data.update(_theory_predictions(law, model, scheme, run["tau"]))
+    attrs = provenance(model, p, law, scheme, **run)
+    attrs["residual_norm_dtype"] = "float32"
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _stability_radius(alpha_norm, bounded) -> float:
+    """Largest δ with every sampled ‖α⁰‖ ≤ δ bounded: just below the smallest failure."""
+    if bounded.all():
+        return float(alpha_norm.max())
+    return float(alpha_norm[~bounded].min())
+
+
+def _theory_predictions(law, model, scheme, tau) -> dict:
+    A_tilde = law.A_tilde(model)
+    lam = np.linalg.eigvals(A_tilde)
+    R = sum(c * np.linalg.matrix_power(tau * A_tilde, j)
+            for j, c in enumerate(scheme.stability_polynomial()))  # fmt: skip
+    rho = float(np.max(np.abs(np.linalg.eigvals(R))))
+    return {
+        "beta_theory": variable((), float(-lam.real.max()),
+                                "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1"),  # fmt: skip
+        "beta_theory_discrete": variable((), -math.log(rho) / tau if rho > 0 else np.inf,
+                                         "discrete decay rate -ln rho(R(tau A~))/tau", "s-1"),  # fmt: skip
+        "spectral_radius": variable((), rho, "spectral radius of R(tau A~)", "1"),
+    }
