@@ -315,46 +315,30 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
         ),
         "state_units": variable("state", model.state_units, "units of each state component", "1"),
     }
-    mixed = "mixed (see state_units)"
-    data = {
-        "residual_norm": variable(
-            ("member", "time"), norms, "max-norm of the constraint residual", "1",
-            comment="stored as float32; NaN after a member stopped",
-        ),  # fmt: skip
-        "alpha0": variable(("member", "component"), alpha0,
-                           "initial perturbation g(x0, t0) achieved", "1"),  # fmt: skip
-        "alpha0_norm": variable("member", alpha_norm, "max-norm of alpha0", "1"),
-        "x0": variable(("member", "state"), x0, "initial state", mixed),
-        "x_final": variable(("member", "state"), x_final,
-                            "final state (last state before a stop)", mixed),  # fmt: skip
-        "beta": variable("member", beta, "fitted decay rate of the residual norm", "s-1",
-                         comment="fit on the transient above the floor, see stabdae._estimate"),  # fmt: skip
-        "gamma": variable("member", gamma, "prefactor: max over the transient of |g| exp(beta t)",
-                          "1"),  # fmt: skip
-        "residual_floor": variable("member", floor,
-                                   "residual level at the end (truncation floor)", "1"),  # fmt: skip
-        "max_residual": variable("member", max_res, "largest residual norm reached", "1"),
-        "bounded": variable("member", bounded.astype(np.int8),
-                            "stayed within epsilon and decayed (Definition 2)", "1",
-                            flag_values=[0, 1], flag_meanings="no yes"),  # fmt: skip
-        "diverged": variable("member", diverged.astype(np.int8), "stopped: blew up", "1",
-                             flag_values=[0, 1], flag_meanings="no yes"),  # fmt: skip
-        "diverged_step": variable("member", fail_step, "step at which the member stopped "
-                                  "(-1: ran to the end)", "1"),  # fmt: skip
-        "status": variable("member", status, "member status", "1", **status_flag_attrs()),
-        "fraction_bounded": variable((), float(bounded.mean()), "fraction of bounded members",
-                                     "1"),  # fmt: skip
-        "stability_radius": variable((), _stability_radius(alpha_norm, bounded),
-                                     "largest |alpha0| below which every member is bounded",
-                                     "1"),  # fmt: skip
-        "beta_median": variable((), float(np.nanmedian(beta)) if np.isfinite(beta).any()
-                                else np.nan, "median fitted decay rate", "s-1"),  # fmt: skip
+    values = {
+        "residual_norm": norms,
+        "alpha0": alpha0,
+        "alpha0_norm": alpha_norm,
+        "x0": x0,
+        "x_final": x_final,
+        "beta": beta,
+        "gamma": gamma,
+        "residual_floor": floor,
+        "max_residual": max_res,
+        "bounded": bounded.astype(np.int8),
+        "diverged": diverged.astype(np.int8),
+        "diverged_step": fail_step,
+        "status": status,
+        "fraction_bounded": float(bounded.mean()),
+        "stability_radius": _stability_radius(alpha_norm, bounded),
+        "beta_median": float(np.nanmedian(beta)) if np.isfinite(beta).any() else np.nan,
     }
     if model.energy is not None:
-        data["energy_drift"] = variable("member", e1 - e0, "energy change E(final) - E(x0)",
-                                        "model units")  # fmt: skip
+        values["energy_drift"] = e1 - e0
     if law.is_constant:
-        data.update(_theory_predictions(law, model, scheme, run["tau"]))
+        values.update(_theory_predictions(law, model, scheme, run["tau"]))
+    data = {name: schema_variable(name, val) for name, val in values.items()}
+    data["status"].attrs.update(status_flag_attrs())
     attrs = provenance(model, p, law, scheme, **run)
     attrs["residual_norm_dtype"] = "float32"
     return xr.Dataset(data, coords=coords, attrs=attrs)
@@ -374,9 +358,43 @@ def _theory_predictions(law, model, scheme, tau) -> dict:
             for j, c in enumerate(scheme.stability_polynomial()))  # fmt: skip
     rho = float(np.max(np.abs(np.linalg.eigvals(R))))
     return {
-        "beta_theory": variable((), float(-lam.real.max()),
-                                "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1"),  # fmt: skip
-        "beta_theory_discrete": variable((), -math.log(rho) / tau if rho > 0 else np.inf,
-                                         "discrete decay rate -ln rho(R(tau A~))/tau", "s-1"),  # fmt: skip
-        "spectral_radius": variable((), rho, "spectral radius of R(tau A~)", "1"),
+        "beta_theory": float(-lam.real.max()),
+        "beta_theory_discrete": -math.log(rho) / tau if rho > 0 else np.inf,
+        "spectral_radius": rho,
     }
+
+
+#: name -> (dims, long_name, units, extra attributes): the ensemble dataset's schema
+ENSEMBLE_SCHEMA = {
+    "residual_norm": (("member", "time"), "max-norm of the constraint residual", "1",
+                      {"comment": "stored as float32; NaN after a member stopped"}),
+    "alpha0": (("member", "component"), "initial perturbation g(x0, t0) achieved", "1", {}),
+    "alpha0_norm": ("member", "max-norm of alpha0", "1", {}),
+    "x0": (("member", "state"), "initial state", "mixed (see state_units)", {}),
+    "x_final": (("member", "state"), "final state (last state before a stop)",
+                "mixed (see state_units)", {}),
+    "beta": ("member", "fitted decay rate of the residual norm", "s-1",
+             {"comment": "fit on the transient above the floor, see stabdae._estimate"}),
+    "gamma": ("member", "prefactor: max over the transient of |g| exp(beta t)", "1", {}),
+    "residual_floor": ("member", "residual level at the end (truncation floor)", "1", {}),
+    "max_residual": ("member", "largest residual norm reached", "1", {}),
+    "bounded": ("member", "stayed within epsilon and decayed (Definition 2)", "1",
+                {"flag_values": [0, 1], "flag_meanings": "no yes"}),
+    "diverged": ("member", "stopped: blew up (diverged, non-finite or singular S)", "1",
+                 {"flag_values": [0, 1], "flag_meanings": "no yes"}),
+    "diverged_step": ("member", "step at which the member stopped (-1: ran to the end)", "1",
+                      {}),
+    "status": ("member", "member status", "1", {}),
+    "energy_drift": ("member", "energy change E(final) - E(x0)", "model units", {}),
+    "fraction_bounded": ((), "fraction of bounded members", "1", {}),
+    "stability_radius": ((), "largest |alpha0| below which every member is bounded", "1", {}),
+    "beta_median": ((), "median fitted decay rate", "s-1", {}),
+    "beta_theory": ((), "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1", {}),
+    "beta_theory_discrete": ((), "discrete decay rate -ln rho(R(tau A~))/tau", "s-1", {}),
+    "spectral_radius": ((), "spectral radius of R(tau A~)", "1", {}),
+}  # fmt: skip
+
+
+def schema_variable(name: str, data) -> xr.Variable:
+    dims, long_name, units, extra = ENSEMBLE_SCHEMA[name]
+    return variable(dims, data, long_name, units, **extra)

@@ -19,8 +19,12 @@ from numba import njit, prange
 from ._linalg import cholesky_inplace, cholesky_solve_inplace
 from ._status import Status
 
-#: relative accuracy asked of ``g(x⁰) = α⁰``
+#: relative accuracy asked of ``g(x⁰) = α⁰``.  Below ``‖α⁰‖ ≈ 1e-4`` it cannot be met in
+#: double precision (evaluating g near x* cancels terms of size |x|²), so a member whose
+#: Newton steps stall at roundoff is accepted when ``|g − α⁰| ≤ 1e-12|α⁰| + ROUNDOFF·ε·|x|²``
+#: (ε the machine epsilon); otherwise it gets ``Status.SAMPLING_FAILED``.
 SAMPLING_RTOL = 1e-12
+ROUNDOFF = 64.0
 MAX_NEWTON = 25
 
 _FAILED = int(Status.SAMPLING_FAILED)
@@ -88,7 +92,7 @@ def build_sampler(K):
                 err = 0.0
                 for i in range(ng):
                     err = max(err, abs(alpha[i] - gp[i]))
-                if err <= SAMPLING_RTOL * max(amax, 1.0):
+                if err <= SAMPLING_RTOL * amax + ROUNDOFF * eps * max(1.0, xnorm) ** 2:
                     return 0, it + 1
                 return _FAILED, it + 1
         return _FAILED, MAX_NEWTON
