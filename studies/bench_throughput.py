@@ -1,0 +1,193 @@
+"""Throughput benchmark: member-steps per second for an ensemble of planar pendulums.
+
+Configuration (issue 3): planar pendulum, explicit midpoint rule (RK2, a = ½, σ = 1),
+Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored every 0.05 s,
+10⁴ and 10⁵ members.  Measured side by side in one run, as ratios to the vectorized C:
+
+* stabdae through the public API (``stabdae.ensemble``), compile time reported apart, and
+  its integration kernel alone (the ``wall_integrate_s`` attribute);
+* C compiled with ``gcc -O3 -march=native -fopenmp``: one member per loop iteration
+  (``run_scalar``) and blocks of 64 members with the member loop innermost (``run_blocked``,
+  vectorized by gcc), both OpenMP-parallel (``studies/bench_c/pendulum_rk2.c``);
+* NumPy vectorized over members;
+* JAX ``lax.scan`` + ``vmap`` when jax is installed.
+
+All start from the same sampled initial states; the final states are compared to make
+sure every variant computes the same thing.
+
+Usage::
+
+    python studies/bench_throughput.py [--members 10000 100000] [--out studies/results]
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import json
+import platform
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+
+import stabdae
+
+HERE = Path(__file__).resolve().parent
+G, L, OMEGA, XI = 9.81, 1.0, 10.0, 1.0
+A0, A1 = -(OMEGA**2), -2.0 * XI * OMEGA
+TAU, T_END, SAVE_DT = 1e-3, 10.0, 0.05
+NSTEPS, SAVE_EVERY = round(T_END / TAU), round(SAVE_DT / TAU)
+
+
+def build_c() -> ctypes.CDLL:
+    out = Path(tempfile.mkdtemp()) / "pendulum_rk2.so"
+    cmd = ["gcc", "-O3", "-march=native", "-fopenmp", "-shared", "-fPIC",
+           str(HERE / "bench_c" / "pendulum_rk2.c"), "-o", str(out), "-lm"]  # fmt: skip
+    subprocess.run(cmd, check=True)
+    lib = ctypes.CDLL(str(out))
+    argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_double, ctypes.c_double,
+                ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_int64,
+                ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p]  # fmt: skip
+    for name in ("run_scalar", "run_blocked"):
+        getattr(lib, name).argtypes = argtypes
+        getattr(lib, name).restype = None
+    return lib
+
+
+def run_c(fn, x0):
+    M = x0.shape[0]
+    norms = np.empty((M, NSTEPS // SAVE_EVERY + 1), dtype=np.float32)
+    xf = np.empty_like(x0)
+    start = time.perf_counter()
+    fn(M, x0.ctypes.data, G, L, A0, A1, TAU, NSTEPS, SAVE_EVERY, norms.ctypes.data,
+       xf.ctypes.data)  # fmt: skip
+    return time.perf_counter() - start, xf
+
+
+def run_numpy(x0):
+    """The same scheme vectorized over members with NumPy (no compilation)."""
+    x, y, vx, vy = (x0[:, i].copy() for i in range(4))
+    norms = np.empty((x0.shape[0], NSTEPS // SAVE_EVERY + 1), dtype=np.float32)
+
+    def acc(x, y, vx, vy):
+        f = x * x + y * y - L * L
+        fd = 2.0 * x * vx + 2.0 * y * vy
+        lam = (A0 * f + A1 * fd - 2.0 * (vx * vx + vy * vy) + 2.0 * y * G) / (4.0 * (x * x + y * y))
+        return 2.0 * x * lam, 2.0 * y * lam - G
+
+    start = time.perf_counter()
+    for i in range(1, NSTEPS + 1):
+        ax, ay = acc(x, y, vx, vy)
+        xm, ym, vxm, vym = x + 0.5 * TAU * vx, y + 0.5 * TAU * vy, vx + 0.5 * TAU * ax, vy + 0.5 * TAU * ay
+        bx, by = acc(xm, ym, vxm, vym)
+        x, y, vx, vy = x + TAU * vxm, y + TAU * vym, vx + TAU * bx, vy + TAU * by
+        if i % SAVE_EVERY == 0:
+            f = np.abs(x * x + y * y - L * L)
+            fd = np.abs(2.0 * x * vx + 2.0 * y * vy)
+            norms[:, i // SAVE_EVERY] = np.maximum(f, fd)
+    return time.perf_counter() - start, np.stack([x, y, vx, vy], axis=1)
+
+
+def run_jax(x0):
+    try:
+        import jax
+        import jax.numpy as jnp
+    except ImportError:
+        return None
+    jax.config.update("jax_enable_x64", True)
+
+    def acc(s):
+        x, y, vx, vy = s
+        f = x * x + y * y - L * L
+        fd = 2.0 * x * vx + 2.0 * y * vy
+        lam = (A0 * f + A1 * fd - 2.0 * (vx * vx + vy * vy) + 2.0 * y * G) / (4.0 * (x * x + y * y))
+        return jnp.stack([vx, vy, 2.0 * x * lam, 2.0 * y * lam - G])
+
+    def member(s0):
+        def save_block(s, _):
+            def step(s, _):
+                mid = s + 0.5 * TAU * acc(s)
+                return s + TAU * acc(mid), None
+
+            s, _ = jax.lax.scan(step, s, None, length=SAVE_EVERY)
+            x, y, vx, vy = s
+            n = jnp.maximum(jnp.abs(x * x + y * y - L * L), jnp.abs(2 * x * vx + 2 * y * vy))
+            return s, n.astype(jnp.float32)
+
+        return jax.lax.scan(save_block, s0, None, length=NSTEPS // SAVE_EVERY)
+
+    fn = jax.jit(jax.vmap(member))
+    small = jnp.asarray(x0[:8])
+    start = time.perf_counter()
+    jax.block_until_ready(fn(small))
+    compile_s = time.perf_counter() - start
+    start = time.perf_counter()
+    xf, _ = jax.block_until_ready(fn(jnp.asarray(x0)))
+    return time.perf_counter() - start, np.asarray(xf), compile_s
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--members", type=int, nargs="+", default=[10_000, 100_000])
+    parser.add_argument("--numpy-members", type=int, default=10_000,
+                        help="NumPy is slow: run it at this size only")  # fmt: skip
+    parser.add_argument("--out", default=str(HERE / "results"))
+    args = parser.parse_args(argv)
+
+    model = stabdae.load_model("pendulum")
+    law = stabdae.baumgarte(OMEGA, XI)
+    start = time.perf_counter()
+    stabdae.ensemble(model, law, "midpoint", TAU, 10 * TAU, members=8, save_dt=TAU)
+    compile_s = time.perf_counter() - start
+    lib = build_c()
+    report = {"machine": platform.processor() or platform.machine(),
+              "threads": numba.get_num_threads(), "stabdae_compile_s": compile_s,
+              "config": dict(tau=TAU, t_end=T_END, save_dt=SAVE_DT, omega=OMEGA, xi=XI),
+              "runs": []}  # fmt: skip
+    print(f"stabdae compile (first call, tiny ensemble): {compile_s:.2f} s; "
+          f"threads: {report['threads']}")
+    for M in args.members:
+        x0, _, _ = stabdae.sample_perturbations(model, M, (1e-6, 1e-2), seed=1)
+        steps = M * NSTEPS
+        start = time.perf_counter()
+        ds = stabdae.ensemble(model, law, "midpoint", TAU, T_END, x0=x0, save_dt=SAVE_DT)
+        api = time.perf_counter() - start
+        kernel = ds.attrs["wall_integrate_s"]
+        t_scalar, xf_scalar = run_c(lib.run_scalar, x0)
+        t_blocked, xf_blocked = run_c(lib.run_blocked, x0)
+        xs = ds.x_final.values
+        row = {"members": M, "member_steps": steps,
+               "stabdae_api_s": api, "stabdae_kernel_s": kernel,
+               "c_scalar_s": t_scalar, "c_blocked_s": t_blocked,
+               "max_diff_vs_c": float(np.max(np.abs(xs - xf_blocked)))}  # fmt: skip
+        if M <= args.numpy_members:
+            row["numpy_s"], xf_np = run_numpy(x0)
+            row["max_diff_numpy_vs_c"] = float(np.max(np.abs(xf_np - xf_blocked)))
+        jax_run = run_jax(x0)
+        if jax_run is not None:
+            row["jax_s"], _, row["jax_compile_s"] = jax_run
+        report["runs"].append(row)
+        print(f"\nmembers = {M}: {steps:.3g} member-steps "
+              f"(final states agree with C to {row['max_diff_vs_c']:.1e})")
+        print(f"{'variant':<28} {'seconds':>9} {'member-steps/s':>15} {'÷ vectorized C':>15}")
+        variants = [("stabdae ensemble (public API)", api), ("stabdae kernel only", kernel),
+                    ("C, one member per iteration", t_scalar), ("C, blocked + vectorized", t_blocked)]  # fmt: skip
+        if "numpy_s" in row:
+            variants.append(("NumPy over members", row["numpy_s"]))
+        if "jax_s" in row:
+            variants.append(("JAX scan + vmap", row["jax_s"]))
+        for name, secs in variants:
+            print(f"{name:<28} {secs:9.3f} {steps / secs:15.3g} {t_blocked / secs:15.3f}")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "bench_throughput.json").write_text(json.dumps(report, indent=2))
+    print(f"\nwritten {out / 'bench_throughput.json'}")
+    return report
+
+
+if __name__ == "__main__":
+    main()
