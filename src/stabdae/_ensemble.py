@@ -54,7 +54,7 @@ def _build_ensemble_kernel(K, step):
     residual, energy, make_workspace = K.residual, K.energy, K.make_workspace
     N2, ng = 2 * K.n, K.ng
 
-    @njit(parallel=True)
+    @njit(parallel=True, error_model="numpy")
     def ensemble_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal,
                         tab_a, tab_b, tab_c, threshold, block,
                         out_norm, x_final, status, fail_step, e0, e1):  # fmt: skip

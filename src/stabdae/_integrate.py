@@ -48,7 +48,7 @@ def _build_stepper(K):
     rhs, residual, energy, make_workspace = K.rhs, K.residual, K.energy, K.make_workspace
     N2, ng = 2 * K.n, K.ng
 
-    @njit
+    @njit(error_model="numpy")
     def step(x, t, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, stages, xs):
         """One explicit RK step, ``x`` updated in place; returns a status code.
 
@@ -76,7 +76,7 @@ def _build_stepper(K):
             x[l] = xs[l]
         return 0
 
-    @njit
+    @njit(error_model="numpy")
     def integrate_kernel(x0, t0, tau, nsteps, save_every, p, law_mat, law_scal,
                          tab_a, tab_b, tab_c, out_x, out_g, out_e):  # fmt: skip
         """Integrate from ``x0`` for ``nsteps`` steps, saving every ``save_every`` steps.

@@ -16,7 +16,7 @@ import math
 from numba import njit
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def cholesky_inplace(a, n, rtol):
     """Lower Cholesky factor of the SPD matrix ``a[:n, :n]``, in place.
 
@@ -45,13 +45,16 @@ def cholesky_inplace(a, n, rtol):
         if d > dmax:
             dmax = d
     tol = rtol * dmax
+    fail = 0
     for j in range(n):
         s = a[j, j]
         for p in range(j):
             s -= a[j, p] * a[j, p]
-        # `not (s > tol)` is also true for NaN, so non-finite input fails here.
-        if not (s > tol) or not math.isfinite(s):
-            return j + 1
+        # `not (s > tol)` is also true for NaN, so non-finite input fails here.  No early
+        # return: the loop stays branch-free enough to vectorize across ensemble members;
+        # after a failure the factor is garbage and the caller must not use it.
+        if fail == 0 and (not (s > tol) or not math.isfinite(s)):
+            fail = j + 1
         d = math.sqrt(s)
         a[j, j] = d
         for i in range(j + 1, n):
@@ -59,10 +62,10 @@ def cholesky_inplace(a, n, rtol):
             for p in range(j):
                 s -= a[i, p] * a[j, p]
             a[i, j] = s / d
-    return 0
+    return fail
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def cholesky_solve_inplace(l, n, b):
     """Solve ``L Lᵀ x = b`` for one right-hand side, overwriting ``b[:n]`` with ``x``.
 
@@ -80,7 +83,7 @@ def cholesky_solve_inplace(l, n, b):
         b[i] = s / l[i, i]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def cholesky_solve_columns(l, n, b, ncols):
     """Solve ``L Lᵀ X = B`` for the columns of ``b[:n, :ncols]``, in place.
 

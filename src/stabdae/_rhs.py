@@ -45,12 +45,12 @@ _SINGULAR_S = int(Status.SINGULAR_S)
 _MASS_NOT_SPD = int(Status.MASS_NOT_SPD)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _noop4(a, b, c, out):  # stands in for an absent (t, q, p, out) piece
     pass
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _noop5(a, b, c, d, out):  # stands in for an absent (t, q, v, p, out) piece
     pass
 
@@ -61,6 +61,20 @@ def _nan_energy(t, q, v, p):
 
 
 Kernels = namedtuple("Kernels", "rhs residual energy make_workspace n m k ng")
+
+
+def _rejit(fn, absent):
+    """The user's function recompiled from its ``py_func`` with the library's flags.
+
+    ``error_model="numpy"`` drops the zero-division branches that a function compiled
+    with the default error model keeps (they silently stop LLVM from vectorizing the
+    ensemble kernel's member loop; a division by zero becomes inf/NaN and then a status),
+    and ``inline="always"`` inlines it at the numba IR level, so that the workspace
+    buffers it writes can live on the stack of the caller.
+    """
+    if fn is None:
+        return absent
+    return njit(error_model="numpy", inline="always")(fn.py_func)
 
 
 def kernels_for(model: Model, bound: BoundLaw) -> Kernels:
@@ -89,21 +103,21 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
     HAS_FT = "f_t" in fns
     HAS_HT = "h_t" in fns
     LAW = law_code
-    mass = fns.get("mass", _noop4)
-    forces = fns["forces"]
-    f_fn = fns.get("f", _noop4)
-    f_q = fns.get("f_q", _noop4)
-    f_t = fns.get("f_t", _noop4)
-    f_accel = fns.get("f_accel", _noop5)
-    h_fn = fns.get("h", _noop5)
-    h_q = fns.get("h_q", _noop5)
-    h_v = fns.get("h_v", _noop5)
-    h_t = fns.get("h_t", _noop5)
-    law_A = law_fn if law_fn is not None else _noop4
+    mass = _rejit(fns.get("mass"), _noop4)
+    forces = _rejit(fns["forces"], None)
+    f_fn = _rejit(fns.get("f"), _noop4)
+    f_q = _rejit(fns.get("f_q"), _noop4)
+    f_t = _rejit(fns.get("f_t"), _noop4)
+    f_accel = _rejit(fns.get("f_accel"), _noop5)
+    h_fn = _rejit(fns.get("h"), _noop5)
+    h_q = _rejit(fns.get("h_q"), _noop5)
+    h_v = _rejit(fns.get("h_v"), _noop5)
+    h_t = _rejit(fns.get("h_t"), _noop5)
+    law_A = _rejit(law_fn, _noop4)
     energy_fn = model.energy if model.energy is not None else _nan_energy
     mk, kk = max(m, 1), max(k, 1)  # buffers for absent blocks keep a harmless size 1
 
-    @njit
+    @njit(error_model="numpy")
     def make_workspace():
         """Every buffer one right-hand-side evaluation needs, allocated once."""
         return (
@@ -125,7 +139,7 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
             np.empty(kk),  # 15 L h (Theorem 5)
         )
 
-    @njit
+    @njit(inline="always")
     def residual(t, x, p, ws, g):
         """g = (f, f_q v + f_t, h) of (3.2) into ``g``; fills ws q, v, f_q, h_v, h_q."""
         q, v, fq, hv, hq, sm, sk = ws[0], ws[1], ws[4], ws[5], ws[6], ws[11], ws[12]
@@ -151,7 +165,7 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
             h_v(t, q, v, p, hv)
             h_q(t, q, v, p, hq)
 
-    @njit
+    @njit(inline="always", error_model="numpy")
     def rhs(t, x, p, law_mat, law_scal, ws, xdot):
         """Write ẋ of the stabilized system (3.1) into ``xdot``; return a status code.
 
@@ -217,10 +231,12 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
         for i in range(k):
             for j in range(n):
                 Y[j, m + i] = hv[i, j]
+        # No early returns below: a failed factorization is remembered and reported at the
+        # end, so that the ensemble kernel can inline this body into a vectorized loop.
+        bad_mass = False
         if HAS_MASS:
             mass(t, q, p, Mw)
-            if cholesky_inplace(Mw, n, MASS_RTOL) != 0:
-                return _MASS_NOT_SPD
+            bad_mass = cholesky_inplace(Mw, n, MASS_RTOL) != 0
             cholesky_solve_columns(Mw, n, Y, r)
             cholesky_solve_inplace(Mw, n, z)
 
@@ -237,8 +253,7 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
                     fij = fq[i, j] if i < m else hv[i - m, j]
                     s += fij * Y[j, c]
                 S[i, c] = s
-        if cholesky_inplace(S, r, S_RTOL) != 0:
-            return _SINGULAR_S
+        bad_S = cholesky_inplace(S, r, S_RTOL) != 0
         cholesky_solve_inplace(S, r, rl)  # rl is now λ
 
         for j in range(n):
@@ -247,9 +262,13 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
                 s += Y[j, i] * rl[i]
             xdot[j] = v[j]
             xdot[n + j] = s
+        if bad_mass:
+            return _MASS_NOT_SPD
+        if bad_S:
+            return _SINGULAR_S
         return _OK
 
-    @njit
+    @njit(error_model="numpy")
     def energy(t, x, p, ws):
         q, v = ws[0], ws[1]
         for i in range(n):

@@ -37,7 +37,7 @@ def build_sampler(K):
     eps3 = np.finfo(np.float64).eps ** (1.0 / 3.0)
     eps = np.finfo(np.float64).eps
 
-    @njit
+    @njit(error_model="numpy")
     def place(x_ref, t0, p, alpha, ws, G, GGt, r, y, xp, gp, gm, x):
         """Place one member; returns (status, Newton steps)."""
         for l in range(N2):
@@ -97,7 +97,7 @@ def build_sampler(K):
                 return _FAILED, it + 1
         return _FAILED, MAX_NEWTON
 
-    @njit(parallel=True)
+    @njit(parallel=True, error_model="numpy")
     def sample_kernel(x_ref, t0, p, alphas, x_out, alpha_out, status, iters):
         M = alphas.shape[0]
         nchunks = (M + 63) // 64
