@@ -1,109 +1,53 @@
 """Ensembles: many initial constraint perturbations of one model, integrated in parallel.
 
-Layering (STYLE: driver over kernel):
-
-* :func:`ensemble` validates, samples the perturbations (:mod:`._sampling`), calls the
-  compiled kernel, fits decay rates (:mod:`._estimate`) and builds the dataset;
-* the kernel integrates blocks of members in parallel (``prange`` over blocks); each
-  member's whole integration runs inside one compiled loop, with every buffer allocated
-  once per block.  Members never interact, so the results are bit-for-bit the same for
-  any thread count and any block size, and a member that diverges (non-finite state,
-  residual above the divergence threshold, singular ``S``) is frozen and flagged without
-  touching the others.
+Layering (STYLE: driver over kernel): :func:`ensemble` validates, samples the
+perturbations (:mod:`._sampling`), calls the compiled block-lockstep kernel
+(:mod:`._soa`), fits decay rates (:mod:`._estimate`) and builds the dataset.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections import namedtuple
 
 import numba
 import numpy as np
 import xarray as xr
-from numba import njit, prange
 
 from ._dataset import provenance, variable
 from ._estimate import FLOOR_MARGIN, fit_decay
-from ._integrate import _positive, _whole_multiple, stepper_for
+from ._integrate import _positive, _whole_multiple
 from ._laws import as_law, bind_law
 from ._model import Model
 from ._rhs import kernels_for
 from ._sampling import SAMPLING_RTOL, build_sampler, draw_alphas
 from ._schemes import as_scheme
+from ._soa import BLOCK, build_soa_kernel
 from ._status import Status, status_flag_attrs
 
 __all__ = ["ensemble", "sample_perturbations"]
 
 _DIVERGED = int(Status.DIVERGED)
-EnsembleKernels = namedtuple("EnsembleKernels", "sample integrate")
 
 
-def ensemble_kernels_for(model: Model, bound) -> EnsembleKernels:
-    key = ("ensemble", bound.code, bound.fn)
+def sampler_for(model: Model):
+    """The compiled perturbation sampler of ``model`` (memoized)."""
+    key = ("sampler",)
     cache = model._kernel_cache
     if key not in cache:
-        K = kernels_for(model, bound)
-        cache[key] = EnsembleKernels(
-            build_sampler(K), _build_ensemble_kernel(K, stepper_for(model, bound).step)
-        )
+        from ._laws import none
+
+        cache[key] = build_sampler(kernels_for(model, bind_law(none(), model)))
     return cache[key]
 
 
-def _build_ensemble_kernel(K, step):
-    residual, energy, make_workspace = K.residual, K.energy, K.make_workspace
-    N2, ng = 2 * K.n, K.ng
-
-    @njit(parallel=True, error_model="numpy")
-    def ensemble_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal,
-                        tab_a, tab_b, tab_c, threshold, block,
-                        out_norm, x_final, status, fail_step, e0, e1):  # fmt: skip
-        """Integrate every row of ``x0s``; see :func:`ensemble` for the outputs.
-
-        ``out_norm`` must be pre-filled (NaN): samples after a failure are not written.
-        """
-        M = x0s.shape[0]
-        nblocks = (M + block - 1) // block
-        for b in prange(nblocks):
-            ws = make_workspace()
-            stages = np.empty((tab_b.shape[0], N2))
-            xs = np.empty(N2)
-            g = np.empty(ng)
-            x = np.empty(N2)
-            for j in range(b * block, min(M, (b + 1) * block)):
-                for l in range(N2):
-                    x[l] = x0s[j, l]
-                e0[j] = energy(t0, x, p, ws)
-                st = 0
-                failed_at = -1
-                k = 0
-                t = t0
-                for i in range(nsteps + 1):
-                    if i > 0:
-                        st = step(x, t, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c,
-                                  ws, stages, xs)  # fmt: skip
-                        if st != 0:
-                            failed_at = i - 1
-                            break
-                        t = t0 + i * tau
-                    if i % save_every == 0:
-                        residual(t, x, p, ws, g)
-                        nrm = 0.0
-                        for l in range(ng):
-                            nrm = max(nrm, abs(g[l]))
-                        out_norm[j, k] = nrm
-                        k += 1
-                        if not (nrm <= threshold):
-                            st = _DIVERGED
-                            failed_at = i
-                            break
-                status[j] = st
-                fail_step[j] = failed_at
-                for l in range(N2):
-                    x_final[j, l] = x[l]
-                e1[j] = energy(t, x, p, ws)
-
-    return ensemble_kernel
+def ensemble_kernel_for(model: Model, bound, stages: int, block: int):
+    """The block-lockstep ensemble kernel (memoized per law kind, stage count, block)."""
+    key = ("ensemble", bound.code, bound.fn, stages, block)
+    cache = model._kernel_cache
+    if key not in cache:
+        cache[key] = build_soa_kernel(kernels_for(model, bound), stages, block)
+    return cache[key]
 
 
 # --------------------------------------------------------------------- sampling
@@ -136,9 +80,7 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
 
 
 def _place(model, targets, p, t0):
-    from ._laws import none
-
-    sampler = ensemble_kernels_for(model, bind_law(none(), model)).sample
+    sampler = sampler_for(model)
     M = targets.shape[0]
     x0 = np.empty((M, 2 * model.n))
     alpha0 = np.empty_like(targets)
@@ -183,7 +125,7 @@ def ensemble(
     params=None,
     epsilon: float | None = None,
     divergence: float | None = None,
-    block: int = 64,
+    block: int = BLOCK,
 ) -> xr.Dataset:
     """Integrate an ensemble of initial constraint perturbations in parallel.
 
@@ -213,7 +155,8 @@ def ensemble(
         Residual norm above which a member is frozen and flagged ``diverged``
         (default ``1e3 × epsilon``).
     block : int
-        Members per parallel work item.  Does not change any number.
+        Members integrated in lockstep per parallel work item (compile-time: a new value
+        compiles a new kernel).  Does not change any number.
 
     Returns
     -------
@@ -252,7 +195,6 @@ def ensemble(
 
     bound = bind_law(law, model)
     clock = time.perf_counter()
-    kernels = ensemble_kernels_for(model, bound)
     if x0 is None:
         x0, alpha0, status = sample_perturbations(
             model, _count(members, "members"), (low, high), seed, params=p
@@ -276,10 +218,11 @@ def ensemble(
     fail_step = np.full(M, -1, dtype=np.int64)
     e0 = np.full(M, np.nan)
     e1 = np.full(M, np.nan)
+    kernel = ensemble_kernel_for(model, bound, scheme.stages, block)
     clock = time.perf_counter()
-    kernels.integrate(
+    kernel(
         np.ascontiguousarray(x0), t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
-        scheme.A, scheme.b, scheme.c, divergence, block, norms, x_final, run_status,
+        scheme.A, scheme.b, scheme.c, divergence, norms, x_final, run_status,
         fail_step, e0, e1,
     )  # fmt: skip
     wall_integrate = time.perf_counter() - clock
