@@ -6,6 +6,12 @@ costs more in dispatch than in arithmetic.  These routines work in place on call
 buffers, allocate nothing and never raise: a failed factorization is reported through the
 return value, which the caller turns into a status code.
 
+The factorization is ``A = L D Lᵀ`` (L unit lower triangular) rather than Cholesky: no
+square roots, and the reciprocal pivots are stored so that a solve is multiplications
+only.  For the common ``r = 1`` constraint matrix, λ then costs one division — the same
+arithmetic as a hand-written ``λ = rhs / S``.  Loops have no early exits, so the code
+vectorizes when inlined into the ensemble kernel's member loop.
+
 Only the leading ``n×n`` block of a buffer is touched, so one buffer can serve several sizes.
 """
 
@@ -17,11 +23,12 @@ from numba import njit
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def cholesky_inplace(a, n, rtol):
-    """Lower Cholesky factor of the SPD matrix ``a[:n, :n]``, in place.
+def ldl_inplace(a, n, rtol):
+    """``a[:n, :n] = L D Lᵀ`` in place, for a symmetric positive definite matrix.
 
-    On return the lower triangle (diagonal included) of ``a[:n, :n]`` holds ``L`` with
-    ``a = L Lᵀ``; the strict upper triangle is left as it was and must not be read.
+    On return the strict lower triangle of ``a[:n, :n]`` holds ``L`` (unit diagonal not
+    stored) and the diagonal holds ``1/d_j``; the strict upper triangle is not touched and
+    must not be read.
 
     Parameters
     ----------
@@ -31,72 +38,73 @@ def cholesky_inplace(a, n, rtol):
     n : int
         Size of the block.
     rtol : float
-        A pivot ``d_j ≤ rtol · max_i |a_ii|`` (or a non-finite pivot) counts as a
-        failure: the matrix is singular, indefinite or not finite to working precision.
+        A pivot ``d_j ≤ rtol · max_i |a_ii|`` (or a non-finite pivot) counts as a failure:
+        the matrix is singular, indefinite or not finite to working precision.
 
     Returns
     -------
     int
-        ``0`` on success, otherwise ``j + 1`` for the first failing pivot ``j``.
+        ``0`` on success, otherwise ``j + 1`` for the first failing pivot ``j`` (the
+        factor is then garbage and must not be used).
     """
     dmax = 0.0
     for i in range(n):
-        d = abs(a[i, i])
-        if d > dmax:
-            dmax = d
+        dmax = max(dmax, abs(a[i, i]))
     tol = rtol * dmax
     fail = 0
     for j in range(n):
-        s = a[j, j]
+        # row j: first w_p = L_jp d_p = a_jp − Σ_{q<p} w_q L_pq (rows p < j are final) …
         for p in range(j):
-            s -= a[j, p] * a[j, p]
-        # `not (s > tol)` is also true for NaN, so non-finite input fails here.  No early
-        # return: the loop stays branch-free enough to vectorize across ensemble members;
-        # after a failure the factor is garbage and the caller must not use it.
-        if fail == 0 and (not (s > tol) or not math.isfinite(s)):
+            s = a[j, p]
+            for q in range(p):
+                s -= a[j, q] * a[p, q]
+            a[j, p] = s
+        # … then L_jp = w_p / d_p and d_j = a_jj − Σ_p w_p L_jp
+        d = a[j, j]
+        for p in range(j):
+            w = a[j, p]
+            ljp = w * a[p, p]
+            d -= w * ljp
+            a[j, p] = ljp
+        if fail == 0 and (not (d > tol) or not math.isfinite(d)):
             fail = j + 1
-        d = math.sqrt(s)
-        a[j, j] = d
-        for i in range(j + 1, n):
-            s = a[i, j]
-            for p in range(j):
-                s -= a[i, p] * a[j, p]
-            a[i, j] = s / d
+        a[j, j] = 1.0 / d
     return fail
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def cholesky_solve_inplace(l, n, b):
-    """Solve ``L Lᵀ x = b`` for one right-hand side, overwriting ``b[:n]`` with ``x``.
+def ldl_solve_inplace(l, n, b):
+    """Solve ``L D Lᵀ x = b`` for one right-hand side, overwriting ``b[:n]`` with ``x``.
 
-    ``l`` is the output of :func:`cholesky_inplace`. Nothing is checked.
+    ``l`` is the output of :func:`ldl_inplace`. Nothing is checked.
     """
     for i in range(n):  # L y = b
         s = b[i]
         for p in range(i):
             s -= l[i, p] * b[p]
-        b[i] = s / l[i, i]
-    for i in range(n - 1, -1, -1):  # Lᵀ x = y
+        b[i] = s
+    for i in range(n):  # D z = y
+        b[i] *= l[i, i]
+    for i in range(n - 1, -1, -1):  # Lᵀ x = z
         s = b[i]
         for p in range(i + 1, n):
             s -= l[p, i] * b[p]
-        b[i] = s / l[i, i]
+        b[i] = s
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def cholesky_solve_columns(l, n, b, ncols):
-    """Solve ``L Lᵀ X = B`` for the columns of ``b[:n, :ncols]``, in place.
-
-    ``l`` is the output of :func:`cholesky_inplace`. Nothing is checked.
-    """
+def ldl_solve_columns(l, n, b, ncols):
+    """Solve ``L D Lᵀ X = B`` for the columns of ``b[:n, :ncols]``, in place."""
     for c in range(ncols):
         for i in range(n):
             s = b[i, c]
             for p in range(i):
                 s -= l[i, p] * b[p, c]
-            b[i, c] = s / l[i, i]
+            b[i, c] = s
+        for i in range(n):
+            b[i, c] *= l[i, i]
         for i in range(n - 1, -1, -1):
             s = b[i, c]
             for p in range(i + 1, n):
                 s -= l[p, i] * b[p, c]
-            b[i, c] = s / l[i, i]
+            b[i, c] = s

@@ -6,7 +6,7 @@ Per evaluation (DESIGN §3)::
     F      = [f_q ; h_v]                        (r × n)
     g      = (f, f_q v + f_t, h)                (3.2)
     c      = (f_accel ; h_q v + h_t)            convective terms of (f̈, ḣ)
-    M      = L Lᵀ (Cholesky)                    skipped for identity mass
+    M      = L D Lᵀ                            skipped for identity mass
     Y      = M⁻¹ Fᵀ,  z = M⁻¹ γ
     S      = F Y                                (r × r, SPD when F has full row rank)
     S λ    = A g − s,   s = c − F z             (3.11)
@@ -31,11 +31,11 @@ import numpy as np
 from numba import njit
 
 from ._laws import LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw
-from ._linalg import cholesky_inplace, cholesky_solve_columns, cholesky_solve_inplace
+from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
 from ._model import Model
 from ._status import Status
 
-# Relative pivot thresholds of the Cholesky factorizations: a pivot below RTOL·max|diag|
+# Relative pivot thresholds of the L D Lᵀ factorizations: a pivot below RTOL·max|diag|
 # reports a singular matrix instead of producing huge or NaN multipliers.
 MASS_RTOL = 1e-14
 S_RTOL = 1e-12
@@ -123,13 +123,13 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
         return (
             np.empty(n),  # 0 q
             np.empty(n),  # 1 v
-            np.empty((n, n)),  # 2 M, then its Cholesky factor
+            np.empty((n, n)),  # 2 M, then its L D Lᵀ factor
             np.empty(n),  # 3 γ, then z = M⁻¹γ
             np.empty((mk, n)),  # 4 f_q
             np.empty((kk, n)),  # 5 h_v
             np.empty((kk, n)),  # 6 h_q
             np.empty((n, r)),  # 7 Y = M⁻¹Fᵀ
-            np.empty((r, r)),  # 8 S, then its Cholesky factor
+            np.empty((r, r)),  # 8 S, then its L D Lᵀ factor
             np.empty(r),  # 9 right side of (3.11), then λ
             np.empty(ng),  # 10 g
             np.empty(mk),  # 11 scratch of size m (f, f_t, f_accel)
@@ -236,11 +236,11 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
         bad_mass = False
         if HAS_MASS:
             mass(t, q, p, Mw)
-            bad_mass = cholesky_inplace(Mw, n, MASS_RTOL) != 0
-            cholesky_solve_columns(Mw, n, Y, r)
-            cholesky_solve_inplace(Mw, n, z)
+            bad_mass = ldl_inplace(Mw, n, MASS_RTOL) != 0
+            ldl_solve_columns(Mw, n, Y, r)
+            ldl_solve_inplace(Mw, n, z)
 
-        # S = F Y (symmetric; lower triangle suffices for Cholesky) and rl += F z
+        # S = F Y (symmetric; the lower triangle suffices for L D Lᵀ) and rl += F z
         for i in range(r):
             s = 0.0
             for j in range(n):
@@ -253,8 +253,8 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
                     fij = fq[i, j] if i < m else hv[i - m, j]
                     s += fij * Y[j, c]
                 S[i, c] = s
-        bad_S = cholesky_inplace(S, r, S_RTOL) != 0
-        cholesky_solve_inplace(S, r, rl)  # rl is now λ
+        bad_S = ldl_inplace(S, r, S_RTOL) != 0
+        ldl_solve_inplace(S, r, rl)  # rl is now λ
 
         for j in range(n):
             s = -z[j]

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ._linalg import cholesky_inplace, cholesky_solve_inplace
+from ._linalg import ldl_inplace, ldl_solve_inplace
 from ._status import Status
 
 #: relative accuracy asked of ``g(x⁰) = α⁰``.  Below ``‖α⁰‖ ≈ 1e-4`` it cannot be met in
@@ -72,11 +72,11 @@ def build_sampler(K):
                     for l in range(N2):
                         s += G[i, l] * G[k, l]
                     GGt[i, k] = s
-            if cholesky_inplace(GGt, ng, 1e-14) != 0:
+            if ldl_inplace(GGt, ng, 1e-14) != 0:
                 return _FAILED, it
             for i in range(ng):
                 y[i] = r[i]
-            cholesky_solve_inplace(GGt, ng, y)
+            ldl_solve_inplace(GGt, ng, y)
             step = 0.0
             xnorm = 0.0
             for l in range(N2):

@@ -159,21 +159,24 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
                         for l in range(N2):
                             Kst[s, l, j] = xd[l]
                 for j in range(B):
+                    # x_{k+1} = x_k + τ Σ b_s k_s, kept only for an active member whose
+                    # step succeeded and stayed finite (frozen members keep their state)
                     finite = True
                     for l in range(N2):
                         acc = 0.0
                         for s in range(S_):
                             acc += tab_b[s] * Kst[s, l, j]
-                        new = X[l, j] + tau * acc
-                        finite = finite and math.isfinite(new)
-                        xs_new = new if (code[j] == 0 and active[j]) else X[l, j]
-                        Kst[0, l, j] = xs_new  # stage 0 is recomputed next step: scratch
-                    if code[j] == 0 and not finite:
-                        code[j] = _NONFINITE
-                for j in range(B):
-                    ok = active[j] and code[j] == 0
+                        finite &= math.isfinite(X[l, j] + tau * acc)
+                    c = code[j]
+                    c = _NONFINITE if (c == 0 and not finite) else c
+                    code[j] = c
+                    ok = active[j] and c == 0
                     for l in range(N2):
-                        X[l, j] = Kst[0, l, j] if ok else X[l, j]
+                        acc = 0.0
+                        for s in range(S_):
+                            acc += tab_b[s] * Kst[s, l, j]
+                        new = X[l, j] + tau * acc
+                        X[l, j] = new if ok else X[l, j]
                 for j in range(cnt):
                     if active[j] and code[j] != 0:
                         active[j] = False
