@@ -8,7 +8,9 @@ Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored e
   its integration kernel alone (the ``wall_integrate_s`` attribute);
 * C compiled with ``gcc -O3 -march=native -fopenmp``: one member per loop iteration
   (``run_scalar``) and blocks of 64 members with the member loop innermost (``run_blocked``,
-  vectorized by gcc), both OpenMP-parallel (``studies/bench_c/pendulum_rk2.c``);
+  vectorized by gcc), both OpenMP-parallel (``studies/bench_c/pendulum_rk2.c``); the blocked
+  form also with ``-ffp-contract=off`` (no fused multiply-adds: the same IEEE arithmetic as
+  stabdae, which does not use fastmath);
 * NumPy vectorized over members;
 * JAX ``lax.scan`` + ``vmap`` when jax is installed.
 
@@ -43,9 +45,9 @@ TAU, T_END, SAVE_DT = 1e-3, 10.0, 0.05
 NSTEPS, SAVE_EVERY = round(T_END / TAU), round(SAVE_DT / TAU)
 
 
-def build_c() -> ctypes.CDLL:
+def build_c(*extra: str) -> ctypes.CDLL:
     out = Path(tempfile.mkdtemp()) / "pendulum_rk2.so"
-    cmd = ["gcc", "-O3", "-march=native", "-fopenmp", "-shared", "-fPIC",
+    cmd = ["gcc", "-O3", "-march=native", "-fopenmp", *extra, "-shared", "-fPIC",
            str(HERE / "bench_c" / "pendulum_rk2.c"), "-o", str(out), "-lm"]  # fmt: skip
     subprocess.run(cmd, check=True)
     lib = ctypes.CDLL(str(out))
@@ -145,6 +147,9 @@ def main(argv=None) -> dict:
     stabdae.ensemble(model, law, "midpoint", TAU, 10 * TAU, members=8, save_dt=TAU)
     compile_s = time.perf_counter() - start
     lib = build_c()
+    # gcc contracts a*b + c into FMAs by default; numba keeps IEEE mul-then-add (no
+    # fastmath), so the strict-IEEE C build is the like-for-like arithmetic reference
+    lib_ieee = build_c("-ffp-contract=off")
     report = {"machine": platform.processor() or platform.machine(),
               "threads": numba.get_num_threads(), "stabdae_compile_s": compile_s,
               "config": dict(tau=TAU, t_end=T_END, save_dt=SAVE_DT, omega=OMEGA, xi=XI),
@@ -160,10 +165,12 @@ def main(argv=None) -> dict:
         kernel = ds.attrs["wall_integrate_s"]
         t_scalar, xf_scalar = run_c(lib.run_scalar, x0)
         t_blocked, xf_blocked = run_c(lib.run_blocked, x0)
+        t_ieee, _ = run_c(lib_ieee.run_blocked, x0)
         xs = ds.x_final.values
         row = {"members": M, "member_steps": steps,
                "stabdae_api_s": api, "stabdae_kernel_s": kernel,
                "c_scalar_s": t_scalar, "c_blocked_s": t_blocked,
+               "c_blocked_no_fma_s": t_ieee,
                "max_diff_vs_c": float(np.max(np.abs(xs - xf_blocked)))}  # fmt: skip
         if M <= args.numpy_members:
             row["numpy_s"], xf_np = run_numpy(x0)
@@ -177,7 +184,8 @@ def main(argv=None) -> dict:
         print(f"{'variant':<28} {'seconds':>9} {'member-steps/s':>15} {'÷ vectorized C':>15}")
         variants = [("stabdae ensemble (public API)", api), ("stabdae kernel only", kernel),
                     ("C, one member per iteration", t_scalar),
-                    ("C, blocked + vectorized", t_blocked)]  # fmt: skip
+                    ("C, blocked + vectorized", t_blocked),
+                    ("C, blocked, -ffp-contract=off", t_ieee)]  # fmt: skip
         if "numpy_s" in row:
             variants.append(("NumPy over members", row["numpy_s"]))
         if "jax_s" in row:
