@@ -23,6 +23,18 @@ def variable(dims, data, long_name: str, units: str, **attrs) -> xr.Variable:
     return xr.Variable(dims, data, attrs={"long_name": long_name, "units": units, **attrs})
 
 
+def model_coords(model, times) -> dict:
+    """Coordinates every stabdae dataset of a model shares: time, state, component."""
+    return {
+        "time": variable("time", times, "time", "s"),
+        "state": variable("state", model.state_names, "state component x = (q, v)", "1"),
+        "component": variable(
+            "component", model.component_names, "residual component g = (f, fdot, h) (3.2)", "1"
+        ),
+        "state_units": variable("state", model.state_units, "units of each state component", "1"),
+    }
+
+
 def flat_attrs(prefix: str, values: dict) -> dict:
     """Flatten a mapping into NetCDF-storable attributes ``<prefix><key>``."""
     out = {}

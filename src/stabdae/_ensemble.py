@@ -14,7 +14,7 @@ import numba
 import numpy as np
 import xarray as xr
 
-from ._dataset import provenance, variable
+from ._dataset import model_coords, provenance, variable
 from ._estimate import FLOOR_MARGIN, fit_decay
 from ._integrate import _positive, _whole_multiple
 from ._laws import as_law, bind_law
@@ -261,12 +261,7 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
 
     coords = {
         "member": variable("member", np.arange(x0.shape[0]), "ensemble member", "1"),
-        "time": variable("time", times, "time", "s"),
-        "state": variable("state", model.state_names, "state component x = (q, v)", "1"),
-        "component": variable(
-            "component", model.component_names, "residual component g = (f, fdot, h) (3.2)", "1"
-        ),
-        "state_units": variable("state", model.state_units, "units of each state component", "1"),
+        **model_coords(model, times),
     }
     values = {
         "residual_norm": norms,

@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 from numba import njit
 
-from ._dataset import provenance, variable
+from ._dataset import model_coords, provenance, variable
 from ._laws import as_law, bind_law
 from ._model import Model
 from ._rhs import kernels_for
@@ -241,14 +241,7 @@ def integrate(
 
 
 def _trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, run):
-    coords = {
-        "time": variable("time", times, "time", "s"),
-        "state": variable("state", model.state_names, "state component x = (q, v)", "1"),
-        "component": variable(
-            "component", model.component_names, "residual component g = (f, fdot, h) (3.2)", "1"
-        ),
-        "state_units": variable("state", model.state_units, "units of each state component", "1"),
-    }
+    coords = model_coords(model, times)
     data = {
         "x": variable(
             ("time", "state"), xs, "state x = (q, v)", "mixed (see state_units)",
