@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from ._dataset import model_coords, provenance, variable
-from ._estimate import FLOOR_MARGIN, fit_decay
+from ._estimate import fit_decay
 from ._integrate import _positive, _whole_multiple
 from ._laws import as_law, bind_law
 from ._model import Model
@@ -28,6 +28,8 @@ from ._status import Status, status_flag_attrs
 __all__ = ["ensemble", "sample_perturbations"]
 
 _DIVERGED = int(Status.DIVERGED)
+#: a member "decayed" when it ended below max(‖α⁰‖, this × the ensemble's median floor)
+DECAYED_FLOOR_FACTOR = 10.0
 
 
 def sampler_for(model: Model):
@@ -85,8 +87,7 @@ def _place(model, targets, p, t0):
     x0 = np.empty((M, 2 * model.n))
     alpha0 = np.empty_like(targets)
     status = np.zeros(M, dtype=np.int8)
-    iters = np.zeros(M, dtype=np.int64)
-    sampler(model.reference_state(p), t0, p, targets, x0, alpha0, status, iters)
+    sampler(model.reference_state(p), t0, p, targets, x0, alpha0, status)
     return x0, alpha0, status
 
 
@@ -253,7 +254,7 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
     max_res = np.where(nvalid > 0, np.nanmax(np.where(finite, norms, -np.inf), axis=1), np.nan)
     final = norms[np.arange(norms.shape[0]), np.maximum(nvalid - 1, 0)].astype(np.float64)
     floor_ref = float(np.nanmedian(np.where(ok, floor, np.nan))) if ok.any() else np.nan
-    decayed = ok & (final <= np.maximum(alpha_norm, FLOOR_MARGIN / 3 * floor_ref))
+    decayed = ok & (final <= np.maximum(alpha_norm, DECAYED_FLOOR_FACTOR * floor_ref))
     bounded = ok & (max_res <= epsilon) & decayed
     diverged = status == int(Status.DIVERGED)
     diverged |= status == int(Status.NONFINITE_STATE)

@@ -295,16 +295,6 @@ class Model:
             parts.append(self.evaluate("h", t, x, p))
         return np.concatenate(parts)
 
-    def constraint_matrix(self, x: np.ndarray, t: float | None = None, p=None) -> np.ndarray:
-        """``F`` (r×n): the rows ``f_q`` over the rows ``h_v`` (DESIGN §1)."""
-        t = self.t0 if t is None else t
-        rows = []
-        if self.m:
-            rows.append(self.evaluate("f_q", t, x, p))
-        if self.k:
-            rows.append(self.evaluate("h_v", t, x, p))
-        return np.vstack(rows)
-
     def check(self, params=None, *, states: int = 3, radius: float = 1e-2, seed: int = 0,
               rtol: float = 1e-6):  # fmt: skip
         """Compare the derivative pieces with finite differences; see :func:`stabdae.check`."""

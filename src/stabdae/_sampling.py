@@ -39,7 +39,7 @@ def build_sampler(K):
 
     @njit(error_model="numpy")
     def place(x_ref, t0, p, alpha, ws, G, GGt, r, y, xp, gp, gm, x):
-        """Place one member; returns (status, Newton steps)."""
+        """Place one member; returns its status."""
         for l in range(N2):
             x[l] = x_ref[l]
         amax = 0.0
@@ -52,7 +52,7 @@ def build_sampler(K):
                 r[i] = alpha[i] - gp[i]
                 err = max(err, abs(r[i]))
             if err <= SAMPLING_RTOL * amax:
-                return 0, it
+                return 0
             if it == MAX_NEWTON:
                 break
             # G = ∂g/∂x by central differences
@@ -73,7 +73,7 @@ def build_sampler(K):
                         s += G[i, l] * G[k, l]
                     GGt[i, k] = s
             if ldl_inplace(GGt, ng, 1e-14) != 0:
-                return _FAILED, it
+                return _FAILED
             for i in range(ng):
                 y[i] = r[i]
             ldl_solve_inplace(GGt, ng, y)
@@ -93,12 +93,12 @@ def build_sampler(K):
                 for i in range(ng):
                     err = max(err, abs(alpha[i] - gp[i]))
                 if err <= SAMPLING_RTOL * amax + ROUNDOFF * eps * max(1.0, xnorm) ** 2:
-                    return 0, it + 1
-                return _FAILED, it + 1
-        return _FAILED, MAX_NEWTON
+                    return 0
+                return _FAILED
+        return _FAILED
 
     @njit(parallel=True, error_model="numpy")
-    def sample_kernel(x_ref, t0, p, alphas, x_out, alpha_out, status, iters):
+    def sample_kernel(x_ref, t0, p, alphas, x_out, alpha_out, status):
         M = alphas.shape[0]
         nchunks = (M + 63) // 64
         for c in prange(nchunks):
@@ -112,9 +112,7 @@ def build_sampler(K):
             gm = np.empty(ng)
             x = np.empty(N2)
             for j in range(c * 64, min(M, (c + 1) * 64)):
-                st, it = place(x_ref, t0, p, alphas[j], ws, G, GGt, r, y, xp, gp, gm, x)
-                status[j] = st
-                iters[j] = it
+                status[j] = place(x_ref, t0, p, alphas[j], ws, G, GGt, r, y, xp, gp, gm, x)
                 for l in range(N2):
                     x_out[j, l] = x[l]
                 residual(t0, x, p, ws, gp)

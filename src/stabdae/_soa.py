@@ -101,7 +101,7 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
         )  # fmt: skip
 
     @njit(error_model="numpy")
-    def save_sample(X, j, t, p, ws, g, xs, threshold):
+    def save_sample(X, j, t, p, ws, g, xs):
         for l in range(N2):
             xs[l] = X[l, j]
         residual(t, xs, p, ws, g)
@@ -135,7 +135,7 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
                 for l in range(N2):
                     xs_h[l] = X[l, j]
                 e0[lo + j] = energy(t0, xs_h, p, ws_h)
-                nrm = save_sample(X, j, t0, p, ws_h, g, xs_h, threshold)
+                nrm = save_sample(X, j, t0, p, ws_h, g, xs_h)
                 out_norm[lo + j, 0] = nrm
                 if not (nrm <= threshold):
                     active[j] = False
@@ -161,22 +161,20 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
                 for j in range(B):
                     # x_{k+1} = x_k + τ Σ b_s k_s, kept only for an active member whose
                     # step succeeded and stayed finite (frozen members keep their state)
+                    xn = stack1(N2)
                     finite = True
                     for l in range(N2):
                         acc = 0.0
                         for s in range(S_):
                             acc += tab_b[s] * Kst[s, l, j]
-                        finite &= math.isfinite(X[l, j] + tau * acc)
+                        xn[l] = X[l, j] + tau * acc
+                        finite &= math.isfinite(xn[l])
                     c = code[j]
                     c = _NONFINITE if (c == 0 and not finite) else c
                     code[j] = c
                     ok = active[j] and c == 0
                     for l in range(N2):
-                        acc = 0.0
-                        for s in range(S_):
-                            acc += tab_b[s] * Kst[s, l, j]
-                        new = X[l, j] + tau * acc
-                        X[l, j] = new if ok else X[l, j]
+                        X[l, j] = xn[l] if ok else X[l, j]
                 for j in range(cnt):
                     if active[j] and code[j] != 0:
                         active[j] = False
@@ -186,7 +184,7 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
                     tn = t0 + i * tau
                     for j in range(cnt):
                         if active[j]:
-                            nrm = save_sample(X, j, tn, p, ws_h, g, xs_h, threshold)
+                            nrm = save_sample(X, j, tn, p, ws_h, g, xs_h)
                             out_norm[lo + j, i // save_every] = nrm
                             if not (nrm <= threshold):
                                 active[j] = False
