@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 import time
 
-import numba
 import numpy as np
 import xarray as xr
 
@@ -20,10 +19,11 @@ from ._integrate import _positive, _whole_multiple
 from ._laws import as_law, bind_law
 from ._model import Model
 from ._rhs import kernels_for
-from ._sampling import SAMPLING_RTOL, build_sampler, draw_alphas
+from ._sampling import CHUNK, SAMPLING_RTOL, build_residual_rows, build_sampler, draw_alphas
 from ._schemes import as_scheme
 from ._soa import BLOCK, build_soa_kernel
 from ._status import Status, status_flag_attrs
+from ._threads import default_threads, run_chunks
 
 __all__ = ["ensemble", "sample_perturbations"]
 
@@ -54,7 +54,7 @@ def ensemble_kernel_for(model: Model, bound, stages: int, block: int):
 
 # --------------------------------------------------------------------- sampling
 def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0, *,
-                         params=None, t0=None):  # fmt: skip
+                         params=None, t0=None, threads=None):  # fmt: skip
     """Initial states ``x⁰`` with prescribed constraint perturbations ``g(x⁰, t0) = α⁰``.
 
     Parameters
@@ -63,6 +63,12 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
     radius : float or (low, high)
         ``‖α⁰‖∞`` is log-uniform in ``[low, high]``; directions are uniform.
     seed : int or numpy.random.Generator
+    params : mapping or array, optional
+    t0 : float, optional
+        Time of the initial states (default the model's ``t0``).
+    threads : int, optional
+        Threads to place the members on (default numba's thread count); no number depends
+        on it.
 
     Returns
     -------
@@ -78,17 +84,36 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
     low, high = _radius(radius)
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     targets = draw_alphas(model.n_residual, _count(members, "members"), (low, high), rng)
-    return _place(model, targets, p, t0)
+    return _place(model, targets, p, t0, threads)
 
 
-def _place(model, targets, p, t0):
+def _place(model, targets, p, t0, threads=None):
     sampler = sampler_for(model)
     M = targets.shape[0]
     x0 = np.empty((M, 2 * model.n))
     alpha0 = np.empty_like(targets)
     status = np.zeros(M, dtype=np.int8)
-    sampler(model.reference_state(p), t0, p, targets, x0, alpha0, status)
+    x_ref = model.reference_state(p)
+    run_chunks(
+        lambda lo, hi: sampler(x_ref, t0, p, targets, x0, alpha0, status, lo, hi),
+        -(-M // CHUNK), threads=threads,
+    )  # fmt: skip
     return x0, alpha0, status
+
+
+def _residual_rows(model, x, p, t0, threads=None):
+    """``g(x_i, t0)`` for every row of ``x`` (compiled; NaN rows give NaN)."""
+    key = ("residual_rows",)
+    cache = model._kernel_cache
+    if key not in cache:
+        from ._laws import none
+
+        cache[key] = build_residual_rows(kernels_for(model, bind_law(none(), model)))
+    out = np.empty((x.shape[0], model.n_residual))
+    kernel = cache[key]
+    run_chunks(lambda lo, hi: kernel(x, t0, p, out, lo, hi), -(-x.shape[0] // CHUNK),
+               threads=threads)  # fmt: skip
+    return out
 
 
 def _radius(radius) -> tuple[float, float]:
@@ -127,6 +152,8 @@ def ensemble(
     epsilon: float | None = None,
     divergence: float | None = None,
     block: int = BLOCK,
+    threads: int | None = None,
+    progress=None,
 ) -> xr.Dataset:
     """Integrate an ensemble of initial constraint perturbations in parallel.
 
@@ -158,6 +185,11 @@ def ensemble(
     block : int
         Members integrated in lockstep per parallel work item (compile-time: a new value
         compiles a new kernel).  Does not change any number.
+    threads : int, optional
+        Threads to run the blocks on (default numba's thread count, ``NUMBA_NUM_THREADS``).
+        Does not change any number.
+    progress : callable ``(members_done, members)``, optional
+        Called after each chunk of members has been integrated.
 
     Returns
     -------
@@ -198,7 +230,7 @@ def ensemble(
     clock = time.perf_counter()
     if x0 is None:
         x0, alpha0, status = sample_perturbations(
-            model, _count(members, "members"), (low, high), seed, params=p
+            model, _count(members, "members"), (low, high), seed, params=p, threads=threads
         )
     else:
         x0 = np.array(x0, dtype=np.float64)
@@ -206,7 +238,7 @@ def ensemble(
             raise ValueError(
                 f"ensemble: x0 must have shape (members, 2n) = (M, {2 * model.n}), got {x0.shape}"
             )
-        alpha0 = np.stack([model.residual(x, t0, p) for x in x0])
+        alpha0 = _residual_rows(model, x0, p, t0, threads)
         status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
         status = status.astype(np.int8)
     M = x0.shape[0]
@@ -221,10 +253,15 @@ def ensemble(
     e1 = np.full(M, np.nan)
     kernel = ensemble_kernel_for(model, bound, scheme.stages, block)
     clock = time.perf_counter()
-    kernel(
-        np.ascontiguousarray(x0), t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
-        scheme.A, scheme.b, scheme.c, divergence, norms, x_final, run_status,
-        fail_step, e0, e1,
+    x0c = np.ascontiguousarray(x0)
+    run_chunks(
+        lambda lo, hi: kernel(
+            x0c, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,
+            scheme.b, scheme.c, divergence, norms, x_final, run_status, fail_step, e0, e1,
+            lo, hi,
+        ),
+        -(-M // block), threads=threads,
+        progress=None if progress is None else lambda done, _: progress(min(M, done * block), M),
     )  # fmt: skip
     wall_integrate = time.perf_counter() - clock
     status = np.where(status != 0, status, run_status).astype(np.int8)
@@ -236,7 +273,7 @@ def ensemble(
         dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every, steps=nsteps,
              members=M, seed=seed, radius_low=low, radius_high=high, epsilon=epsilon,
              divergence=divergence, sampling_rtol=SAMPLING_RTOL,
-             threads=numba.get_num_threads()),
+             threads=threads if threads is not None else default_threads()),
     )  # fmt: skip
     # wall times (compilation included on a first call) for benchmarks; not part of the data
     ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,

@@ -10,6 +10,7 @@ import numpy as np
 import xarray as xr
 from numba import njit
 
+from ._cache import kernel_key, keyed_cache
 from ._dataset import model_coords, provenance, variable
 from ._laws import as_law, bind_law
 from ._model import Model
@@ -108,6 +109,8 @@ def _build_stepper(K):
                 j += 1
         return 0, nsteps
 
+    keyed_cache(step, kernel_key(K.key, "step"))
+    keyed_cache(integrate_kernel, kernel_key(K.key, "integrate"))
     return Stepper(step, integrate_kernel)
 
 

@@ -30,6 +30,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
+from ._cache import fingerprint, optional_fingerprint
 from ._laws import LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw
 from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
 from ._model import Model
@@ -60,7 +61,9 @@ def _nan_energy(t, q, v, p):
     return math.nan
 
 
-Kernels = namedtuple("Kernels", "rhs residual energy make_workspace n m k ng")
+Kernels = namedtuple("Kernels", "rhs residual energy make_workspace n m k ng key")
+Kernels.__doc__ = """The compiled pieces of one (model, law kind); ``key`` identifies what they
+were compiled from (:mod:`._cache`), ``None`` when a function has no source file."""
 
 
 def _rejit(fn, absent):
@@ -91,10 +94,8 @@ def kernels_for(model: Model, bound: BoundLaw) -> Kernels:
 
 
 def _build(model: Model, law_code: int, law_fn) -> Kernels:
-    # No cache=True on these closures: numba keys a closure's cache entry on a pickle of
-    # the captured dispatchers, which carries a per-process id, so the on-disk cache would
-    # never hit (seen with numba 0.68: a new cache file on every run).  The library's own
-    # self-contained kernels (_linalg) are cached.
+    # These closures are inlined into the kernels that Python calls (integrate, sample,
+    # ensemble); those get an explicit on-disk cache key from :mod:`._cache`.
     # Compile-time constants of the closure.
     n, m, k = model.n, model.m, model.k
     r, ng = m + k, 2 * m + k
@@ -276,4 +277,9 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
             v[i] = x[n + i]
         return energy_fn(t, q, v, p)
 
-    return Kernels(rhs, residual, energy, make_workspace, n, m, k, ng)
+    key = fingerprint(
+        "kernels", n, m, k,
+        tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
+        optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
+    )  # fmt: skip
+    return Kernels(rhs, residual, energy, make_workspace, n, m, k, ng, key)

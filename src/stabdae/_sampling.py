@@ -14,8 +14,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
+from ._cache import kernel_key, keyed_cache
 from ._linalg import ldl_inplace, ldl_solve_inplace
 from ._status import Status
 
@@ -26,12 +27,15 @@ from ._status import Status
 SAMPLING_RTOL = 1e-12
 ROUNDOFF = 64.0
 MAX_NEWTON = 25
+#: members per work item of the sampler
+CHUNK = 64
 
 _FAILED = int(Status.SAMPLING_FAILED)
 
 
 def build_sampler(K):
-    """Compiled, member-parallel Gauss–Newton placement for the kernels ``K``."""
+    """Compiled Gauss–Newton placement for the kernels ``K``, over chunks of 64 members
+(:data:`CHUNK`; run on threads by :func:`._threads.run_chunks`)."""
     residual, make_workspace = K.residual, K.make_workspace
     N2, ng = 2 * K.n, K.ng
     eps3 = np.finfo(np.float64).eps ** (1.0 / 3.0)
@@ -97,11 +101,11 @@ def build_sampler(K):
                 return _FAILED
         return _FAILED
 
-    @njit(parallel=True, error_model="numpy")
-    def sample_kernel(x_ref, t0, p, alphas, x_out, alpha_out, status):
+    @njit(nogil=True, error_model="numpy")
+    def sample_kernel(x_ref, t0, p, alphas, x_out, alpha_out, status, c_lo, c_hi):
+        """Place the members of chunks ``c_lo … c_hi − 1`` (64 members each)."""
         M = alphas.shape[0]
-        nchunks = (M + 63) // 64
-        for c in prange(nchunks):
+        for c in range(c_lo, c_hi):
             ws = make_workspace()
             G = np.empty((ng, N2))
             GGt = np.empty((ng, ng))
@@ -111,7 +115,7 @@ def build_sampler(K):
             gp = np.empty(ng)
             gm = np.empty(ng)
             x = np.empty(N2)
-            for j in range(c * 64, min(M, (c + 1) * 64)):
+            for j in range(c * CHUNK, min(M, (c + 1) * CHUNK)):
                 status[j] = place(x_ref, t0, p, alphas[j], ws, G, GGt, r, y, xp, gp, gm, x)
                 for l in range(N2):
                     x_out[j, l] = x[l]
@@ -119,7 +123,28 @@ def build_sampler(K):
                 for i in range(ng):
                     alpha_out[j, i] = gp[i]
 
-    return sample_kernel
+    return keyed_cache(sample_kernel, kernel_key(K.key, "sample"))
+
+
+def build_residual_rows(K):
+    """Compiled ``g(x_i, t0)`` for the rows of an array of states, over chunks of
+    :data:`CHUNK` rows."""
+    residual, make_workspace = K.residual, K.make_workspace
+    N2, ng = 2 * K.n, K.ng
+
+    @njit(nogil=True, error_model="numpy")
+    def residual_rows(x, t0, p, out, c_lo, c_hi):
+        ws = make_workspace()
+        g = np.empty(ng)
+        xs = np.empty(N2)
+        for j in range(c_lo * CHUNK, min(x.shape[0], c_hi * CHUNK)):
+            for l in range(N2):
+                xs[l] = x[j, l]
+            residual(t0, xs, p, ws, g)
+            for i in range(ng):
+                out[j, i] = g[i]
+
+    return keyed_cache(residual_rows, kernel_key(K.key, "residual_rows"))
 
 
 def draw_alphas(ng: int, members: int, radius, rng: np.random.Generator) -> np.ndarray:

@@ -207,4 +207,9 @@ def as_scheme(scheme, **params) -> Scheme:
         raise SchemeError(
             f"unknown scheme {scheme!r}; known: {sorted(set(_BY_NAME) | {'two_stage'})}"
         )
+    if callable(scheme) and getattr(scheme, "__module__", "") == __name__:
+        raise SchemeError(
+            f"scheme: got the function stabdae.{scheme.__name__}; call it "
+            f"(stabdae.{scheme.__name__}(...)) or pass the name {scheme.__name__!r}"
+        )
     raise SchemeError(f"scheme must be a Scheme or a name, got {type(scheme).__name__}")

@@ -1,11 +1,12 @@
 """The ensemble kernel: blocks of members in lockstep, structure of arrays, member innermost.
 
-Each parallel work item (``prange`` over blocks) holds a block of ``BLOCK`` members as
-arrays ``X[state, member]`` and ``K[stage, state, member]``.  Every stage is one loop over
-the members of the block; its body is the whole stabilized right-hand side of one member
-(:mod:`._rhs`, the user's functions inlined) working on buffers that live on the stack
-(:func:`stack1`, :func:`stack2`).  With no heap arrays, no calls and no early exits left in
-the body, LLVM turns those buffers into registers and vectorizes the loop across members.
+Each work item (a block; ranges of blocks run on threads, :mod:`._threads`) holds a block
+of ``BLOCK`` members as arrays ``X[state, member]`` and ``K[stage, state, member]``.  Every
+stage is one loop over the members of the block; its body is the whole stabilized
+right-hand side of one member (:mod:`._rhs`, the user's functions inlined) working on
+buffers that live on the stack (:func:`stack1`, :func:`stack2`).  With no heap arrays, no
+calls and no early exits left in the body, LLVM turns those buffers into registers and
+vectorizes the loop across members.
 
 Members never interact, so results are bit-for-bit the same for any thread count and any
 block size, and identical to :func:`stabdae.integrate` for the same initial state (same
@@ -19,10 +20,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange, types
+from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from ._cache import kernel_key, keyed_cache
 from ._status import Status
 
 BLOCK = 64
@@ -110,14 +112,15 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
             nrm = max(nrm, abs(g[l]))
         return nrm
 
-    @njit(parallel=True, error_model="numpy")
+    @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a, tab_b, tab_c,
-                   threshold, out_norm, x_final, status, fail_step, e0, e1):  # fmt: skip
-        """Integrate every row of ``x0s``; outputs as in :func:`stabdae.ensemble`.
-        ``out_norm`` must be pre-filled (NaN): samples after a stop are not written."""
+                   threshold, out_norm, x_final, status, fail_step, e0, e1,
+                   b_lo, b_hi):  # fmt: skip
+        """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
+        :func:`stabdae.ensemble`.  ``out_norm`` must be pre-filled (NaN): samples after a
+        stop are not written.  Releases the GIL (run by :func:`._threads.run_chunks`)."""
         M = x0s.shape[0]
-        nblocks = (M + B - 1) // B
-        for b in prange(nblocks):
+        for b in range(b_lo, b_hi):
             lo = b * B
             cnt = min(B, M - lo)
             X = np.empty((N2, B))
@@ -197,4 +200,4 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
                     xs_h[l] = X[l, j]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
 
-    return soa_kernel
+    return keyed_cache(soa_kernel, kernel_key(K.key, "soa", stages, block))

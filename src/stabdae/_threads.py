@@ -1,0 +1,70 @@
+"""Running a compiled ``nogil`` kernel over chunks of members on a pool of threads.
+
+The ensemble and sampling kernels are plain ``@njit(nogil=True)`` functions over a range
+of work items (blocks of members), not ``parallel=True`` functions: numba's parfor
+machinery doubles their compile time (measured 12.6 s → 5.8 s on the double pendulum
+kernel), and chunks driven from Python give progress reports and a clean stop on
+Ctrl-C between chunks.  Work items never share outputs, so the numbers do not depend on
+the thread count or on which thread ran which chunk.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import numba
+
+__all__ = ["default_threads", "run_chunks"]
+
+
+def default_threads() -> int:
+    """Threads used by default: numba's setting (``NUMBA_NUM_THREADS``, else the cores)."""
+    return max(1, int(numba.get_num_threads()))
+
+
+def _chunks(items: int, threads: int, per_thread: int = 8) -> list[tuple[int, int]]:
+    size = max(1, -(-items // (threads * per_thread)))
+    return [(lo, min(items, lo + size)) for lo in range(0, items, size)]
+
+
+def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None) -> None:
+    """Call ``kernel(lo, hi)`` for consecutive ranges covering ``range(items)``.
+
+    ``kernel`` must release the GIL (a ``nogil`` dispatcher called with arguments bound by
+    the caller).  ``progress(done, items)`` is called from the calling thread after each
+    chunk.  The first chunk runs alone, so that compilation happens once.
+    """
+    if items <= 0:
+        return
+    threads = default_threads() if threads is None else max(1, int(threads))
+    threads = min(threads, items, os.cpu_count() or threads)
+    chunks = _chunks(items, threads)
+    done = 0
+    lo, hi = chunks[0]
+    kernel(lo, hi)
+    done += hi - lo
+    if progress is not None:
+        progress(done, items)
+    rest = chunks[1:]
+    if not rest:
+        return
+    if threads == 1:
+        for lo, hi in rest:
+            kernel(lo, hi)
+            done += hi - lo
+            if progress is not None:
+                progress(done, items)
+        return
+    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="stabdae") as pool:
+        futures = [(hi - lo, pool.submit(kernel, lo, hi)) for lo, hi in rest]
+        try:
+            for size, fut in futures:
+                fut.result()
+                done += size
+                if progress is not None:
+                    progress(done, items)
+        except BaseException:
+            for _, fut in futures:
+                fut.cancel()
+            raise
