@@ -98,3 +98,36 @@ def test_cache_can_be_switched_off(monkeypatch, value):
     d = njit(lambda x: x)
     before = d._cache
     assert keyed_cache(d, "some-key") is d and d._cache is before
+
+
+INTEGRATE = textwrap.dedent(
+    """
+    import json, sys
+    import stabdae
+    out = {}
+    for name in sys.argv[1:]:
+        model = stabdae.load_model(name)
+        ds = stabdae.ensemble(model, stabdae.baumgarte(200.0, 0.5), "euler", 1e-3, 0.2,
+                              members=8, radius=(1e-6, 1e-4), seed=1)
+        out[name] = [ds.x_final.values.tolist(), ds.energy_drift.values.tolist()]
+    print(json.dumps(out))
+    """
+)
+
+
+def test_a_kernel_loaded_from_the_cache_does_not_capture_a_fresh_compile(tmp_path):
+    """Process 1 compiles and caches the pendulum's kernels.  Process 2 loads them, then
+    compiles the double pendulum's (the same closures under the same names but for the
+    key, see ``_cache.tag``).  Both must give the numbers of runs without any cache."""
+
+    def run(*names, cache=str(tmp_path)):
+        env = dict(os.environ, STABDAE_CACHE_DIR=cache, PYTHONPATH=str(SRC))
+        out = subprocess.run([sys.executable, "-c", INTEGRATE, *names], env=env, check=True,
+                             capture_output=True, text=True, timeout=300)  # fmt: skip
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    first = run("pendulum")
+    both = run("pendulum", "double_pendulum")
+    reference = run("double_pendulum", cache="off")
+    assert both["pendulum"] == first["pendulum"]
+    assert both["double_pendulum"] == reference["double_pendulum"]

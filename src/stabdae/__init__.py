@@ -4,6 +4,7 @@ numerical integration, after R. G. Mukharlyamov's constraint-perturbation equati
 The public API is exactly what this module re-exports.
 """
 
+from . import theory  # noqa: E402  (submodule: stabdae.theory)
 from ._ensemble import ensemble, sample_perturbations
 from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, baumgarte, matrix, none, theorem5, user
@@ -36,6 +37,7 @@ __all__ = [
     "sample_perturbations",
     "scene_names",
     "theorem5",
+    "theory",
     "two_stage",
     "user",
 ]

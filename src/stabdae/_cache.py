@@ -42,7 +42,8 @@ from numba.core.caching import (
     _CacheLocator,
 )
 
-__all__ = ["cache_dir", "clear", "fingerprint", "function_fingerprint", "kernel_key", "keyed_cache"]
+__all__ = ["cache_dir", "clear", "fingerprint", "function_fingerprint", "kernel_key", "keyed_cache",
+           "tag"]
 
 
 def cache_dir() -> Path | None:
@@ -206,9 +207,30 @@ class _KeyedCache(FunctionCache):
         return (sig, codegen.magic_tuple(), self._key)
 
 
+def tag(key: str | None, *dispatchers) -> None:
+    """Make the compiled symbol names of closures unique to ``key``.
+
+    numba names a compiled function after its qualified name and a per-process counter.
+    Two closures of the same qualified name (the same kernel built for two models),
+    compiled in two processes, can therefore get the same symbol, and once both are loaded
+    from the cache into one process a call may resolve to the other model's code (seen:
+    the double pendulum's ensemble running the pendulum's energy function).  Appending the
+    kernel key to the qualified name of every closure that is compiled on its own rules
+    that out.  Must run before the first compilation.
+    """
+    if key is None:
+        return
+    for d in dispatchers:
+        py_func = getattr(d, "py_func", d)
+        suffix = f"_{key[:16]}"
+        if not py_func.__qualname__.endswith(suffix):
+            py_func.__qualname__ += suffix
+
+
 def keyed_cache(dispatcher, key: str | None):
     """Give ``dispatcher`` an on-disk cache under ``key`` (no-op for ``key=None`` or when
     caching is off); returns the dispatcher."""
+    tag(key, dispatcher)
     path = cache_dir()
     if key is None or path is None:
         return dispatcher

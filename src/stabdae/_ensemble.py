@@ -154,6 +154,7 @@ def ensemble(
     block: int = BLOCK,
     threads: int | None = None,
     progress=None,
+    residual_dtype="float32",
 ) -> xr.Dataset:
     """Integrate an ensemble of initial constraint perturbations in parallel.
 
@@ -190,6 +191,9 @@ def ensemble(
         Does not change any number.
     progress : callable ``(members_done, members)``, optional
         Called after each chunk of members has been integrated.
+    residual_dtype : "float32" or "float64"
+        Storage of ``residual_norm``: float32 (default) halves the memory of large
+        ensembles (10⁶ members × 200 samples: 0.8 GB); float64 keeps every digit.
 
     Returns
     -------
@@ -222,6 +226,11 @@ def ensemble(
                 f"ensemble: t_end - t0 = {span:g} must be a whole multiple of save_dt = {save_dt:g}"
             )
     block = _count(block, "block")
+    rdtype = np.dtype(residual_dtype) if str(residual_dtype) in ("float32", "float64") else None
+    if rdtype is None:
+        raise ValueError(
+            f"ensemble: residual_dtype must be 'float32' or 'float64', got {residual_dtype!r}"
+        )
     low, high = _radius(radius)
     epsilon = 10.0 * high if epsilon is None else _positive(epsilon, "epsilon")
     divergence = 1e3 * epsilon if divergence is None else _positive(divergence, "divergence")
@@ -245,7 +254,7 @@ def ensemble(
     wall_sample = time.perf_counter() - clock
 
     nsave = nsteps // save_every + 1
-    norms = np.full((M, nsave), np.nan, dtype=np.float32)
+    norms = np.full((M, nsave), np.nan, dtype=rdtype)
     x_final = np.empty_like(x0)
     run_status = np.zeros(M, dtype=np.int8)
     fail_step = np.full(M, -1, dtype=np.int64)
@@ -321,12 +330,15 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
     }
     if model.energy is not None:
         values["energy_drift"] = e1 - e0
-    if law.is_constant:
-        values.update(_theory_predictions(law, model, scheme, run["tau"]))
+    values.update(_theory_values(law, model, p, scheme, run["tau"], x0, x_final, times, norms,
+                                 alpha0, floor))  # fmt: skip
     data = {name: schema_variable(name, val) for name, val in values.items()}
     data["status"].attrs.update(status_flag_attrs())
+    data["residual_norm"].attrs["comment"] = (
+        f"stored as {norms.dtype}; " + data["residual_norm"].attrs["comment"]
+    )
     attrs = provenance(model, p, law, scheme, **run)
-    attrs["residual_norm_dtype"] = "float32"
+    attrs["residual_norm_dtype"] = str(norms.dtype)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -337,23 +349,35 @@ def _stability_radius(alpha_norm, bounded) -> float:
     return float(alpha_norm[~bounded].min())
 
 
-def _theory_predictions(law, model, scheme, tau) -> dict:
-    A_tilde = law.A_tilde(model)
-    lam = np.linalg.eigvals(A_tilde)
-    R = sum(c * np.linalg.matrix_power(tau * A_tilde, j)
-            for j, c in enumerate(scheme.stability_polynomial()))  # fmt: skip
-    rho = float(np.max(np.abs(np.linalg.eigvals(R))))
-    return {
-        "beta_theory": float(-lam.real.max()),
-        "beta_theory_discrete": -math.log(rho) / tau if rho > 0 else np.inf,
-        "spectral_radius": rho,
-    }
+def _theory_values(law, model, p, scheme, tau, x0, x_final, times, norms, alpha0,
+                   floor) -> dict:  # fmt: skip
+    """The theorems' predictions stored beside the measurements (:mod:`stabdae.theory`)."""
+    from . import theory
+    from ._laws import Theorem5
+
+    if law.is_constant:
+        return theory.predictions(model, law, scheme, tau)
+    if not isinstance(law, Theorem5):
+        return {}
+    # Theorem 5 over the states the ensemble visited (its initial and final states)
+    states = np.concatenate([x0, x_final])
+    c = theory.theorem5(model, law, states, params=p)
+    out = {"lambda_min_W": c["lambda_min_W"], "beta_theorem5_proven": c["beta_proven"],
+           "beta_theorem5_printed": c["beta_printed"]}  # fmt: skip
+    # the Lyapunov argument bounds the 2-norm: γ = √(l_m/l₁)‖α⁰‖₂ also bounds ‖α(t)‖∞
+    alpha2 = np.linalg.norm(alpha0, axis=1)
+    for which in ("proven", "printed"):
+        out[f"bound_{which}_held"] = theory.bound_held(
+            times, norms, alpha2, c[f"beta_{which}"], c["gamma_factor"], floor
+        ).astype(np.int8)
+    out["gamma_theorem5"] = c["gamma_factor"] * alpha2
+    return out
 
 
 #: name -> (dims, long_name, units, extra attributes): the ensemble dataset's schema
 ENSEMBLE_SCHEMA = {
     "residual_norm": (("member", "time"), "max-norm of the constraint residual", "1",
-                      {"comment": "stored as float32; NaN after a member stopped"}),
+                      {"comment": "NaN after a member stopped"}),
     "alpha0": (("member", "component"), "initial perturbation g(x0, t0) achieved", "1", {}),
     "alpha0_norm": ("member", "max-norm of alpha0", "1", {}),
     "x0": (("member", "state"), "initial state", "mixed (see state_units)", {}),
@@ -378,6 +402,25 @@ ENSEMBLE_SCHEMA = {
     "beta_theory": ((), "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1", {}),
     "beta_theory_discrete": ((), "discrete decay rate -ln rho(R(tau A~))/tau", "s-1", {}),
     "spectral_radius": ((), "spectral radius of R(tau A~)", "1", {}),
+    "norm_max": ((), "max-norm of R(tau A~) (the paper's norm; Theorems 6, 7)", "1", {}),
+    "norm_weighted": ((), "norm of R(tau A~) in the discrete-Lyapunov weight", "1",
+                      {"comment": "inf when no weight exists (spectral radius >= 1)"}),
+    "norm_condition": ((), "weighted-norm condition of Theorems 6/7 holds", "1",
+                       {"flag_values": [0, 1], "flag_meanings": "no yes"}),
+    "lambda_min_W": ((), "min eigenvalue of W = h_v h_v^T over x0 and x_final", "1", {}),
+    "beta_theorem5_proven": ((), "Theorem 5 rate k0 lambda_min(W) l1^2/lm (proven)", "s-1",
+                             {}),
+    "beta_theorem5_printed": ((), "Theorem 5 rate k0 w0 l1^2/lm as printed, w0^2 = "
+                              "lambda_min(W)", "s-1", {}),
+    "gamma_theorem5": ("member", "Theorem 5 prefactor |alpha0|_2 sqrt(lm/l1)", "1", {}),
+    "bound_proven_held": ("member", "|alpha(t)| <= gamma exp(-beta t) held, proven beta",
+                          "1", {"flag_values": [0, 1], "flag_meanings": "no yes",
+                                "comment": "judged above 10x the member's residual floor, "
+                                "that floor added to the bound"}),
+    "bound_printed_held": ("member", "|alpha(t)| <= gamma exp(-beta t) held, printed beta",
+                           "1", {"flag_values": [0, 1], "flag_meanings": "no yes",
+                                 "comment": "judged above 10x the member's residual floor, "
+                                "that floor added to the bound"}),
 }  # fmt: skip
 
 

@@ -30,7 +30,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ._cache import fingerprint, optional_fingerprint
+from ._cache import fingerprint, optional_fingerprint, tag
 from ._laws import LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw
 from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
 from ._model import Model
@@ -115,7 +115,9 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
     h_v = _rejit(fns.get("h_v"), _noop5)
     h_t = _rejit(fns.get("h_t"), _noop5)
     law_A = _rejit(law_fn, _noop4)
-    energy_fn = model.energy if model.energy is not None else _nan_energy
+    # inlined like the other pieces: a separately compiled user function would carry a
+    # symbol name shared by every model's "energy" (see _cache.tag)
+    energy_fn = _rejit(model.energy, _nan_energy)
     mk, kk = max(m, 1), max(k, 1)  # buffers for absent blocks keep a harmless size 1
 
     @njit(error_model="numpy")
@@ -282,4 +284,5 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
         tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
         optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
     )  # fmt: skip
+    tag(key, rhs, residual, energy, make_workspace)
     return Kernels(rhs, residual, energy, make_workspace, n, m, k, ng, key)

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._cache import kernel_key, keyed_cache
+from ._cache import kernel_key, keyed_cache, tag
 from ._linalg import ldl_inplace, ldl_solve_inplace
 from ._status import Status
 
@@ -123,7 +123,9 @@ def build_sampler(K):
                 for i in range(ng):
                     alpha_out[j, i] = gp[i]
 
-    return keyed_cache(sample_kernel, kernel_key(K.key, "sample"))
+    key = kernel_key(K.key, "sample")
+    tag(key, place)
+    return keyed_cache(sample_kernel, key)
 
 
 def build_residual_rows(K):

@@ -24,7 +24,7 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from ._cache import kernel_key, keyed_cache
+from ._cache import kernel_key, keyed_cache, tag
 from ._status import Status
 
 BLOCK = 64
@@ -200,4 +200,6 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
                     xs_h[l] = X[l, j]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
 
-    return keyed_cache(soa_kernel, kernel_key(K.key, "soa", stages, block))
+    key = kernel_key(K.key, "soa", stages, block)
+    tag(key, stack_workspace, save_sample)
+    return keyed_cache(soa_kernel, key)

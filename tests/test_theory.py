@@ -1,0 +1,220 @@
+"""Theorems 3–7 as computations (stabdae.theory) against closed forms, and beside ensembles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import stabdae
+from conftest import load_scene
+from stabdae import theory
+
+
+def baumgarte_At(omega, xi):
+    return np.array([[0.0, 1.0], [-(omega**2), -2.0 * xi * omega]])
+
+
+# --------------------------------------------------------------------- closed forms
+@pytest.mark.parametrize("k", [0.5, 3.0, 40.0])
+def test_scalar_law_limits(k):
+    A = np.array([[-k]])
+    assert theory.continuous(A)["beta"] == pytest.approx(k, rel=1e-15)
+    for scheme in ("euler", "midpoint", "heun"):
+        for cond in theory.CONDITIONS:  # all norms coincide for a scalar
+            assert theory.tau_limit(A, scheme, cond) == pytest.approx(2.0 / k, rel=1e-9)
+    # RK4's real stability interval: the positive root of z³ − 4z² + 12z − 24 = 0
+    z4 = max(r.real for r in np.roots([1, -4, 12, -24]) if abs(r.imag) < 1e-12)
+    assert z4 == pytest.approx(2.785293563405282, rel=1e-12)
+    assert theory.tau_limit(A, "rk4") == pytest.approx(z4 / k, rel=1e-9)
+    d = theory.discrete(A, "euler", 0.5 / k)
+    assert d.spectral_radius == pytest.approx(0.5) and d.norm_max == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("xi", [0.2, 0.5, 0.9])
+def test_baumgarte_euler_limit_is_2xi_below_critical(xi):
+    omega = 7.0
+    A = baumgarte_At(omega, xi)
+    assert theory.tau_limit(A, "euler") * omega == pytest.approx(2.0 * xi, rel=1e-8)
+    assert theory.tau_limit(A, "euler", "weighted_norm") * omega == pytest.approx(
+        2.0 * xi, rel=1e-6
+    )
+    assert theory.continuous(A)["beta"] == pytest.approx(xi * omega, rel=1e-12)
+
+
+def test_baumgarte_critical_limit_is_2_for_euler_and_second_order_two_stage():
+    omega = 10.0
+    A = baumgarte_At(omega, 1.0)
+    for scheme in ("euler", "midpoint", "heun", stabdae.two_stage(0.25, 2.0)):
+        assert theory.tau_limit(A, scheme) * omega == pytest.approx(2.0, rel=1e-7), scheme
+    # overdamped: eigenvalues −ω(ξ ± √(ξ²−1)); Euler limit 2/|λ|max
+    xi = 2.0
+    lam = omega * (xi + math.sqrt(xi * xi - 1.0))
+    assert theory.tau_limit(baumgarte_At(omega, xi), "euler") == pytest.approx(2.0 / lam, 1e-9)
+
+
+def test_max_norm_condition_fails_for_every_tau_when_m_positive():
+    for model_name in ("pendulum", "double_pendulum", "hoop_bead"):
+        model = load_scene(model_name)
+        A = stabdae.baumgarte(10.0, 1.0).A_tilde(model)
+        for scheme in ("euler", "midpoint", "rk4"):
+            assert theory.tau_limit(A, scheme, "max_norm") == 0.0
+            assert theory.tau_limit(A, scheme, "two_norm") == 0.0
+            for tau in (1e-9, 1e-4, 1e-2):
+                R = theory.step_matrix(A, scheme, tau)
+                assert theory.CONDITIONS["max_norm"](R) >= 1.0 + tau * (1 - 1e-9)
+            assert theory.tau_limit(A, scheme, "weighted_norm") > 0.0
+
+
+def test_weighted_norm_condition_holds_exactly_when_spectral_radius_below_one():
+    rng = np.random.default_rng(7)
+    seen = {True: 0, False: 0}
+    for _ in range(300):
+        n = int(rng.integers(1, 5))
+        A = rng.standard_normal((n, n)) - 0.5 * n * np.eye(n) * rng.uniform(0, 2)
+        tau = 10 ** rng.uniform(-2, 0.5)
+        R = theory.step_matrix(A, ["euler", "midpoint", "rk4"][int(rng.integers(3))], tau)
+        rho = theory.spectral_radius(R)
+        if abs(rho - 1.0) < 1e-6:
+            continue
+        assert (theory.weighted_norm(R) < 1.0) == (rho < 1.0), (A, tau, rho)
+        if rho < 1.0:  # ‖R‖_P² = 1 − 1/λ_max(X)
+            P = theory.lyapunov_weight(R)
+            X = P @ P
+            assert theory.weighted_norm(R) ** 2 == pytest.approx(
+                1.0 - 1.0 / np.linalg.eigvalsh(X).max(), rel=1e-6
+            )
+        seen[rho < 1.0] += 1
+    assert seen[True] > 50 and seen[False] > 50
+
+
+def test_lyapunov_uses_the_symmetric_part():
+    # −LÃ has positive leading minors (the paper's test passes) but its symmetric part is
+    # indefinite: V grows along α = (1, 1), so the theorem must not be claimed.
+    A = np.array([[-1.0, 10.0], [0.0, -1.0]])
+    L = np.eye(2)
+    minors_paper = [np.linalg.det((-L @ A)[:i, :i]) for i in (1, 2)]
+    assert all(m > 0 for m in minors_paper)
+    out = theory.lyapunov(A, L)
+    assert not out["holds"]
+    alpha = np.array([1.0, 1.0])
+    assert alpha @ L @ (A @ alpha) > 0  # V̇ > 0
+    # with L from the Lyapunov equation the same Ã is proven stable
+    out = theory.lyapunov(A)
+    assert out["holds"] and out["beta"] > 0
+    # the proven rate never exceeds the true one, and is exact for symmetric Ã with L = I
+    assert out["beta"] <= theory.continuous(A)["beta"] + 1e-12
+    S = np.array([[-3.0, 1.0], [1.0, -2.0]])
+    assert theory.lyapunov(S, np.eye(2))["beta"] == pytest.approx(
+        np.linalg.eigvalsh(-S).min(), rel=1e-12
+    )
+
+
+# --------------------------------------------------------------------- with ensembles
+def test_affine_constraints_follow_R_power_exactly():
+    """Constraints affine in (q, v, t): the residual recursion is exactly g ← R(τÃ) g."""
+    import affine
+
+    model = affine.model
+    law = stabdae.baumgarte(100.0, 1.0, k=50.0)
+    At = law.A_tilde(model)
+    scheme = stabdae.midpoint()
+    limit = theory.tau_limit(At, scheme)
+    assert limit * 100.0 == pytest.approx(2.0, rel=1e-7)  # ξ = 1: τω < 2
+    for factor in (0.95, 1.05):
+        tau = factor * limit
+        nsteps = 200
+        ds = stabdae.ensemble(model, law, scheme, tau, nsteps * tau, members=16,
+                              radius=(1e-3, 1e-2), seed=5, save_dt=10 * tau,
+                              divergence=1e30, epsilon=1e30,
+                              residual_dtype="float64")  # fmt: skip
+        assert ds.residual_norm.dtype == np.float64
+        assert (ds.status == 0).all()
+        R = theory.step_matrix(At, scheme, tau)
+        Rs = np.linalg.matrix_power(R, 10)
+        g = ds.alpha0.values.T.copy()
+        pred = [np.abs(g).max(axis=0)]
+        for _ in range(nsteps // 10):
+            g = Rs @ g
+            pred.append(np.abs(g).max(axis=0))
+        pred = np.array(pred).T
+        got = ds.residual_norm.values
+        # relative to each member's largest residual: the sequence first grows ~ω·f (the
+        # velocity residual picks up the position residual), and roundoff in g(x) is
+        # absolute, at the level of that peak
+        scale = pred.max(axis=1, keepdims=True)
+        err = np.abs(got - pred) / scale
+        assert err.max() <= 1e-10, err.max()
+        rho = theory.spectral_radius(R)
+        if factor < 1:
+            assert rho < 1 and (got[:, -1] < got[:, 0]).all()
+        else:
+            assert rho > 1 and (got[:, -1] > 10 * got[:, 0]).all()
+
+
+def test_theorem5_printed_bound_fails_where_proven_bound_holds():
+    """The sleigh with its constraint row scaled by s_h = 0.5: W = 1/4 < 1, so the printed
+    rate k₀w₀ = k/2 is faster than the true decay e^{−kWt} = e^{−kt/4}, which the proven
+    rate k₀λ_min(W) = k/4 matches."""
+    model = load_scene("chaplygin_sleigh")
+    params = dict(model.params, s_h=0.5)
+    law = stabdae.theorem5(4.0)
+    ds = stabdae.ensemble(model, law, "rk4", 1e-2, 12.0, members=64, radius=(1e-3, 1e-2),
+                          seed=2, params=params, save_dt=0.1)  # fmt: skip
+    assert float(ds.lambda_min_W) == pytest.approx(0.25, rel=1e-12)
+    assert float(ds.beta_theorem5_proven) == pytest.approx(1.0, rel=1e-12)
+    assert float(ds.beta_theorem5_printed) == pytest.approx(2.0, rel=1e-12)
+    assert ds.bound_proven_held.values.all()
+    assert (ds.bound_printed_held.values == 0).sum() >= 32
+    # the measured rate sits at the proven one
+    assert float(ds.beta_median) == pytest.approx(1.0, rel=0.02)
+
+
+@pytest.mark.parametrize("scene", ["pendulum", "double_pendulum"])
+def test_tau_sweep_boundary_matches_the_spectral_radius(scene):
+    """Sweeping τ: every member stays bounded wherever the weighted-norm condition holds,
+    and the empirical boundary is within one grid cell of ρ(R(τÃ)) = 1."""
+    model = load_scene(scene)
+    # ω large against the pendulum's own frequency (~3 s⁻¹): Euler's slow energy growth
+    # of the free swing stays small over the run, and the constraint law sets the limit
+    law = stabdae.baumgarte(200.0, 0.5)
+    At = law.A_tilde(model)
+    limit = theory.tau_limit(At, "euler")
+    assert limit * 200.0 == pytest.approx(1.0, rel=1e-8)  # 2ξ/ω
+    taus = limit * np.array([0.5, 0.7, 0.85, 0.95, 1.05, 1.2, 1.5])
+    empirical, predicted = [], []
+    for tau in taus:
+        # ε = 1: Euler's truncation floor near the limit, τ²/2·‖g⁽²⁾‖/(1 − ρ), is far above
+        # the perturbations, so a smaller ε would count stable runs as unbounded
+        ds = stabdae.ensemble(model, law, "euler", tau, 400 * tau, members=32,
+                              radius=(1e-6, 1e-4), seed=1, save_dt=20 * tau,
+                              epsilon=1.0)  # fmt: skip
+        holds = bool(ds.norm_condition)
+        if holds:
+            assert float(ds.fraction_bounded) == 1.0, tau
+        empirical.append(float(ds.fraction_bounded) == 1.0)
+        predicted.append(float(ds.spectral_radius) < 1.0)
+    # the first τ that is not stable: empirical and predicted within one grid cell
+    first_bad = lambda flags: flags.index(False) if False in flags else len(flags)  # noqa: E731
+    assert abs(first_bad(empirical) - first_bad(predicted)) <= 1
+    assert first_bad(predicted) == 4
+
+
+def test_along_path_floor_bounds_the_residual():
+    """Theorem 6 along a nonlinear path: ‖g_k‖ ≤ max(‖P⁻¹‖‖Pg₀‖, ε) with ε from the
+    measured one-step remainders."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    x0 = stabdae.sample_perturbations(model, 1, (1e-3, 1e-3), seed=4)[0][0]
+    for scheme, tau in (("euler", 0.01), ("midpoint", 0.02)):
+        out = theory.along_path(model, law, scheme, tau, 5.0, x0)
+        assert float(out.q) < 1.0
+        bound = max(float(out.bound_start), float(out.epsilon))
+        assert (out.residual_norm.values <= bound * (1 + 1e-9)).all()
+        # the floor is a real bound, not a vacuous one: within 100x of what is reached
+        late = out.residual_norm.values[len(out.step) // 2 :]
+        assert float(out.epsilon) < 100 * late.max()
+        # constant law: every R_k is the same and its max-norm exceeds 1 (m > 0)
+        assert np.ptp(out.spectral_radius.values) < 1e-15
+        assert (out.norm_max.values > 1.0).all()
