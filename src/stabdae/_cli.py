@@ -1,4 +1,4 @@
-"""Command line: ``stabdae check MODEL`` and ``stabdae integrate [MODEL]``."""
+"""Command line: ``stabdae check``, ``integrate``, ``theory`` (and ``run``, ``plot``)."""
 
 from __future__ import annotations
 
@@ -93,6 +93,31 @@ def _cmd_integrate(args) -> int:
     return 0 if ds.attrs["status"] == 0 else 1
 
 
+def _cmd_theory(args) -> int:
+    from . import theory
+    from ._study import load_study
+
+    study = load_study(args.study)
+    print(study.describe())
+    ds = theory.for_study(study)
+    law = study.setup()["law"]
+    if law.is_constant and not any(n.startswith(("law.", "model.")) for n in study.axes):
+        A = law.A_tilde(study.model)
+        c, ly = theory.continuous(A), theory.lyapunov(A)
+        eig = ", ".join(f"{z:.4g}" for z in c["eigenvalues"])
+        print(f"\nTheorem 3: eigenvalues of Ã: {eig}; decay rate {c['beta']:.6g} s-1 "
+              f"({'stable' if c['stable'] else 'NOT stable'})")
+        print(f"Theorem 4: L from ÃᵀL + LÃ = −I; Sylvester on L and on the symmetric part of "
+              f"−LÃ: {'holds' if ly['holds'] else 'fails'}; proven rate {ly['beta']:.6g} s-1")
+        scheme = study.setup()["scheme"]
+        lims = {c_: theory.tau_limit(A, scheme, c_) for c_ in theory.CONDITIONS}
+        print("Theorems 6/7, largest tau for " + scheme.name + ": " +
+              ", ".join(f"{k} {v:.6g}" for k, v in lims.items()))  # fmt: skip
+    print("\nper grid point (R = R(τÃ); cond: the weighted-norm condition of Theorems 6/7):")
+    print(theory.format_table(ds))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="stabdae",
@@ -128,10 +153,15 @@ def main(argv: list[str] | None = None) -> int:
     itg.add_argument("-o", "--output", help="NetCDF output path")
     itg.set_defaults(func=_cmd_integrate)
 
+    thy = sub.add_parser("theory", help="the theorems' predictions for a study, without "
+                         "running the ensembles")  # fmt: skip
+    thy.add_argument("study", help="study file (TOML)")
+    thy.set_defaults(func=_cmd_theory)
+
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (ValueError, FileExistsError) as exc:
+    except (ValueError, FileExistsError) as exc:  # StudyError, ModelError, LawError, …
         print(f"stabdae {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

@@ -423,3 +423,126 @@ def _square(A, who: str) -> np.ndarray:
         raise ValueError(f"{who}: Ã must be a square matrix, got shape {A.shape}")
     return A
 
+
+
+# --------------------------------------------------------------------- a study's grid
+def for_study(study, *, path_steps: int = 2000) -> xr.Dataset:
+    """The theorems' predictions at every grid point of a study (``stabdae theory``).
+
+    Constant laws: Theorems 3, 4, 6/7 from ``Ã`` alone, nothing integrated.  Theorem 5
+    laws: ``λ_min(W)`` over a sampled neighbourhood of the manifold (the study's
+    perturbations placed around ``x*``, and the reference trajectory) and the discrete
+    conditions along the reference trajectory (its first ``path_steps`` steps).
+    """
+    from ._ensemble import sample_perturbations
+    from ._integrate import integrate
+
+    model = study.model
+    names = list(study.axes)
+    shape = study.shape
+    cols: dict[str, np.ndarray] = {}
+
+    def put(name, idx, value):
+        if name not in cols:
+            cols[name] = np.full(shape, np.nan)
+        cols[name][idx] = value
+
+    neighbourhood = None
+    for idx, values in study.points():
+        s = study.setup(values)
+        law, scheme, tau = s["law"], s["scheme"], s["tau"]
+        p = model.param_vector(s["params"])
+        if law.is_constant:
+            A = law.A_tilde(model)
+            c = continuous(A)
+            ly = lyapunov(A)
+            d = discrete(A, scheme, tau)
+            put("beta_theory", idx, c["beta"])
+            put("lyapunov_holds", idx, float(ly["holds"]))
+            put("beta_lyapunov", idx, ly["beta"])
+            rho = d.spectral_radius
+            put("beta_theory_discrete", idx, -math.log(rho) / tau if rho > 0 else math.inf)
+            for k, v in d.as_dict().items():
+                put(k, idx, v)
+            put("norm_condition", idx, float(d.norm_weighted < 1.0))
+        else:
+            if neighbourhood is None or any(n.startswith("model.") for n in names):
+                x_ref = model.reference_state(p)
+                ens = sample_perturbations(model, study.ensemble["members"],
+                                           study.ensemble["radius"], study.ensemble["seed"],
+                                           params=p)[0]  # fmt: skip
+                traj = integrate(model, x_ref, law, scheme, tau, s["t_end"], s["save_dt"],
+                                 params=p).x.values  # fmt: skip
+                neighbourhood = np.concatenate([ens, traj])
+            c5 = theorem5(model, law, neighbourhood, params=p)
+            for k in ("lambda_min_W", "beta_proven", "beta_printed", "gamma_factor"):
+                put(f"theorem5_{k}", idx, c5[k])
+            t_path = min(s["t_end"], model.t0 + path_steps * tau)
+            t_path = model.t0 + tau * max(2, round((t_path - model.t0) / tau))
+            path = along_path(model, law, scheme, tau, t_path, None, params=p)
+            put("path_spectral_radius_max", idx, float(path.spectral_radius.max()))
+            put("path_norm_weighted_max", idx, float(path.q))
+            put("path_epsilon", idx, float(path.epsilon))
+    data = {k: (names, v, {"long_name": _LONG.get(k, k), "units": _UNITS.get(k, "1")})
+            for k, v in cols.items()}  # fmt: skip
+    ds = xr.Dataset(data, coords={n: (n, v) for n, v in study.axes.items()})
+    ds.attrs.update(model=model.name, law=study.law["kind"], scheme=study.setup()["scheme"].name,
+                    study=str(study.path))  # fmt: skip
+    return ds
+
+
+_LONG = {
+    "beta_theory": "continuous decay rate -max Re eig(A~) (Theorem 3)",
+    "lyapunov_holds": "Theorem 4: Sylvester's criterion on L and the symmetric part of -LA~",
+    "beta_lyapunov": "rate proven by the Lyapunov function, lambda_min(Q)/l_m",
+    "beta_theory_discrete": "discrete decay rate -ln rho(R)/tau",
+    "spectral_radius": "spectral radius of R(tau A~)",
+    "norm_max": "max-norm of R (the paper's norm; Theorems 6, 7)",
+    "norm_2": "2-norm of R",
+    "norm_weighted": "norm of R in the discrete-Lyapunov weight",
+    "norm_condition": "weighted-norm condition holds",
+    "tau_limit_spectral": "largest tau with rho(R) < 1",
+    "tau_limit_max_norm": "largest tau with max-norm of R < 1",
+    "tau_limit_two_norm": "largest tau with 2-norm of R < 1",
+    "tau_limit_weighted_norm": "largest tau with the weighted norm of R < 1",
+}
+_UNITS = {"beta_theory": "s-1", "beta_lyapunov": "s-1", "beta_theory_discrete": "s-1",
+          "tau_limit_spectral": "s", "tau_limit_max_norm": "s", "tau_limit_two_norm": "s",
+          "tau_limit_weighted_norm": "s", "theorem5_beta_proven": "s-1",
+          "theorem5_beta_printed": "s-1"}  # fmt: skip
+
+
+def format_table(ds: xr.Dataset, columns=None) -> str:
+    """A readable table of :func:`for_study`'s dataset, one row per grid point."""
+    dims = list(ds.dims)
+    columns = columns or [v for v in ("spectral_radius", "norm_max", "norm_weighted",
+                                      "norm_condition", "beta_theory", "beta_theory_discrete",
+                                      "lyapunov_holds", "tau_limit_spectral",
+                                      "theorem5_lambda_min_W", "theorem5_beta_proven",
+                                      "theorem5_beta_printed", "path_spectral_radius_max",
+                                      "path_norm_weighted_max", "path_epsilon")
+                          if v in ds]  # fmt: skip
+    short = {"spectral_radius": "rho(R)", "norm_max": "|R|max", "norm_weighted": "|R|P",
+             "norm_condition": "cond", "beta_theory": "beta", "beta_theory_discrete":
+             "beta_disc", "lyapunov_holds": "Lyap", "tau_limit_spectral": "tau_lim",
+             "theorem5_lambda_min_W": "lmin(W)", "theorem5_beta_proven": "b_proven",
+             "theorem5_beta_printed": "b_printed", "path_spectral_radius_max": "rho_path",
+             "path_norm_weighted_max": "q_path", "path_epsilon": "eps_path"}  # fmt: skip
+    head = [d.split(".", 1)[-1] for d in dims] + [short.get(c, c) for c in columns]
+    rows = []
+    flat = ds.stack(point=dims) if dims else ds.expand_dims(point=[0])
+    for i in range(flat.sizes["point"]):
+        row = [f"{float(flat[d].values[i]):.4g}" for d in dims]
+        for c in columns:
+            v = float(flat[c].values[i])
+            if c in ("norm_condition", "lyapunov_holds"):
+                row.append("yes" if v == 1 else "no")
+            elif c in ("norm_weighted", "spectral_radius", "path_norm_weighted_max"):
+                row.append(f"{v:.6g}")  # the digits that decide "< 1"
+            else:
+                row.append(f"{v:.4g}")
+        rows.append(row)
+    width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(head, width))]
+    lines += ["  ".join(x.rjust(w) for x, w in zip(r, width)) for r in rows]
+    return "\n".join(lines)

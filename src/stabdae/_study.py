@@ -1,0 +1,404 @@
+"""Study files (CONTRACT §3): TOML in, a validated :class:`Study` out — before anything
+compiles or runs.
+
+Every error names the file and the key (``study.toml: [run] tau: must be positive, got
+-0.001``).  Sweep axes are named by their key; an unqualified name is looked up in
+``[run]``, ``[law]``, ``[scheme]`` and the model's parameters, and must be unambiguous
+(``law.k`` or ``model.k`` otherwise).  Entries of a constant matrix law are swept as
+``"A[i,j]"`` (indices into the r × (m + r) matrix ``A``).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ._laws import Law, LawError, baumgarte, matrix, none, theorem5
+from ._loading import load_model
+from ._model import Model, ModelError
+from ._schemes import Scheme, SchemeError, as_scheme
+
+__all__ = ["Study", "StudyError", "load_study"]
+
+
+class StudyError(ValueError):
+    """A study file that cannot be run as written."""
+
+
+_SECTIONS = {
+    "model": {"file": str, "params": dict},
+    "law": {"kind": str, "omega": float, "xi": float, "k": float, "A": list, "L": list},
+    "scheme": {"name": str, "a": float, "sigma": float},
+    "run": {"t_end": float, "tau": float, "save_dt": float, "epsilon": float,
+            "divergence": float},  # fmt: skip
+    "ensemble": {"members": int, "radius": (list, float), "seed": int, "block": int},
+    "sweep": None,  # names checked against the other sections
+    "output": {"path": str},
+}
+_REQUIRED = {"model": ("file",), "law": ("kind",), "run": ("t_end", "tau")}
+_LAW_KEYS = {"baumgarte": {"omega", "xi", "k"}, "matrix": {"A"}, "theorem5": {"k", "L"},
+             "none": set()}  # fmt: skip
+_SWEEPABLE_RUN = ("tau",)
+_MATRIX_ENTRY = re.compile(r"^(?:law\.)?A\[(\d+)\s*,\s*(\d+)\]$")
+
+
+@dataclass
+class Study:
+    """A validated study.  ``axes`` maps each swept name (canonical: ``run.tau``,
+    ``law.omega``, ``law.A[1,0]``, ``scheme.a``, ``model.g``) to its values."""
+
+    path: Path
+    model: Model
+    params: dict
+    law: dict
+    scheme: dict
+    run: dict
+    ensemble: dict
+    axes: dict = field(default_factory=dict)
+    output: Path | None = None
+
+    # ----------------------------------------------------------------- grid
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(v) for v in self.axes.values())
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.shape)) if self.axes else 1
+
+    def points(self):
+        """``(index tuple, {axis: value})`` for every grid point, C order."""
+        names = list(self.axes)
+        for idx in itertools.product(*(range(len(v)) for v in self.axes.values())):
+            yield idx, {n: float(self.axes[n][i]) for n, i in zip(names, idx)}
+
+    def setup(self, values: dict | None = None) -> dict:
+        """Everything one grid point needs: ``params``, ``law``, ``scheme``, ``tau``,
+        ``t_end``, ``save_dt``, ``epsilon``, ``divergence``."""
+        values = values or {}
+        params = dict(self.params)
+        law = dict(self.law)
+        scheme = dict(self.scheme)
+        run = dict(self.run)
+        A = None if law.get("A") is None else np.array(law["A"], dtype=float)
+        for name, val in values.items():
+            section, key = name.split(".", 1)
+            if section == "model":
+                params[key] = val
+            elif section == "run":
+                run[key] = val
+            elif section == "scheme":
+                scheme[key] = val
+            elif (m := _MATRIX_ENTRY.match(name)) is not None:
+                A[int(m.group(1)), int(m.group(2))] = val
+            else:
+                law[key] = val
+        save_dt, stride = run.get("save_dt"), 1
+        if save_dt is not None and run["tau"] > save_dt * (1 + 1e-12):
+            stride = round(run["tau"] / save_dt)  # a step spans several samples
+            save_dt = run["tau"]
+        return {
+            "params": params,
+            "law": _make_law(law, A),
+            "scheme": _make_scheme(scheme),
+            "tau": run["tau"],
+            "t_end": run["t_end"],
+            "save_dt": save_dt,
+            "stride": stride,
+            "epsilon": run.get("epsilon"),
+            "divergence": run.get("divergence"),
+        }
+
+    def describe(self) -> str:
+        axes = ", ".join(f"{k} ({len(v)})" for k, v in self.axes.items()) or "none"
+        return (f"study {self.path.name}: model {self.model.name}, law {self.law['kind']}, "
+                f"scheme {self.scheme.get('name', 'rk2')}, {self.ensemble['members']} members "
+                f"× {self.size} grid points; swept: {axes}")  # fmt: skip
+
+
+def _make_law(law: dict, A) -> Law:
+    kind = law["kind"]
+    if kind == "baumgarte":
+        return baumgarte(law.get("omega"), law.get("xi", 1.0), law.get("k"))
+    if kind == "matrix":
+        return matrix(A)
+    if kind == "theorem5":
+        return theorem5(law["k"], law.get("L"))
+    return none()
+
+
+def _make_scheme(scheme: dict) -> Scheme:
+    name = scheme.get("name", "rk2")
+    params = {k: scheme[k] for k in ("a", "sigma") if k in scheme}
+    return as_scheme(name, **params)
+
+
+# --------------------------------------------------------------------- loading
+def load_study(path, *, members: int | None = None) -> Study:
+    """Read and validate a study file (nothing is compiled)."""
+    path = Path(path)
+    where = path.name
+    if not path.is_file():
+        raise StudyError(f"{path}: no such study file")
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"{where}: not valid TOML: {exc}") from None
+
+    def fail(key: str, msg: str):
+        raise StudyError(f"{where}: {key}: {msg}")
+
+    for section in raw:
+        if section not in _SECTIONS:
+            fail(f"[{section}]", f"unknown section; known: {', '.join(_SECTIONS)}")
+        if not isinstance(raw[section], dict):
+            fail(section, "must be a table ([section])")
+    for section, keys in _SECTIONS.items():
+        if keys is None:
+            continue
+        for key, val in raw.get(section, {}).items():
+            if key not in keys:
+                fail(f"[{section}] {key}", f"unknown key; known: {', '.join(keys)}")
+            raw[section][key] = _typed(val, keys[key], f"[{section}] {key}", fail)
+    for section, keys in _REQUIRED.items():
+        for key in keys:
+            if key not in raw.get(section, {}):
+                fail(f"[{section}] {key}", "missing (required)")
+
+    # model
+    mfile = raw["model"]["file"]
+    source = path.parent / mfile if mfile.endswith(".py") else mfile
+    if mfile.endswith(".py") and not Path(source).is_file():
+        fail("[model] file", f"no such model file: {source}")
+    try:
+        model = load_model(source)
+    except ModelError as exc:
+        fail("[model] file", str(exc))
+    params = dict(model.params)
+    for key, val in raw["model"].get("params", {}).items():
+        if key not in params:
+            fail(f"[model] params.{key}", f"model {model.name!r} has no parameter {key!r}; "
+                 f"its parameters: {', '.join(params) or 'none'}")  # fmt: skip
+        params[key] = _typed(val, float, f"[model] params.{key}", fail)
+
+    # law
+    law = dict(raw["law"])
+    kind = law["kind"]
+    if kind not in _LAW_KEYS:
+        fail("[law] kind", f"unknown law {kind!r}; known: {', '.join(_LAW_KEYS)}")
+    for key in law:
+        if key != "kind" and key not in _LAW_KEYS[kind]:
+            fail(f"[law] {key}", f"not a parameter of the {kind!r} law "
+                 f"(its parameters: {', '.join(sorted(_LAW_KEYS[kind])) or 'none'})")  # fmt: skip
+    for key in ("omega", "k"):
+        if key in law and not law[key] > 0:
+            fail(f"[law] {key}", f"must be positive, got {law[key]}")
+    if kind == "baumgarte" and "omega" in law and model.m == 0:
+        fail("[law] omega", f"model {model.name!r} has no holonomic constraints (m = 0)")
+    if kind == "baumgarte" and "k" in law and model.k == 0:
+        fail("[law] k", f"model {model.name!r} has no nonholonomic constraints (k = 0)")
+    if "xi" in law and not law["xi"] >= 0:
+        fail("[law] xi", f"must be non-negative, got {law['xi']}")
+
+    # scheme
+    scheme = dict(raw.get("scheme", {}))
+    try:
+        _make_scheme(scheme)
+    except SchemeError as exc:
+        fail("[scheme] name", str(exc))
+
+    # run
+    run = dict(raw["run"])
+    for key in ("t_end", "tau", "save_dt", "epsilon", "divergence"):
+        if key in run and not (math.isfinite(run[key]) and run[key] > 0):
+            fail(f"[run] {key}", f"must be positive and finite, got {run[key]}")
+
+    # ensemble
+    ens = {"members": 1024, "radius": [1e-6, 1e-2], "seed": 0, "block": 64}
+    ens.update(raw.get("ensemble", {}))
+    if members is not None:
+        ens["members"] = members
+    if ens["members"] < 1:
+        fail("[ensemble] members", f"must be at least 1, got {ens['members']}")
+    radius = ens["radius"]
+    radius = [radius, radius] if isinstance(radius, float) else radius
+    if len(radius) != 2 or not all(isinstance(r, (int, float)) for r in radius):
+        fail("[ensemble] radius", f"must be a number or [low, high], got {ens['radius']}")
+    radius = [float(r) for r in radius]
+    if not (0 < radius[0] <= radius[1] and math.isfinite(radius[1])):
+        fail("[ensemble] radius", f"needs 0 < low <= high, got {radius}")
+    ens["radius"] = radius
+    if ens["block"] < 1:
+        fail("[ensemble] block", f"must be at least 1, got {ens['block']}")
+
+    # sweep
+    axes = {}
+    for name, spec in raw.get("sweep", {}).items():
+        canon = _canonical(name, model, law, scheme, fail)
+        values = _axis_values(spec, f"[sweep] {name}", fail)
+        if canon in axes:
+            fail(f"[sweep] {name}", f"sweeps {canon} twice")
+        axes[canon] = values
+        _check_axis(canon, values, model, law, f"[sweep] {name}", fail)
+
+    if "run.tau" in axes:
+        span = run["t_end"] - model.t0
+        if "save_dt" not in run:
+            run["save_dt"] = span / 200.0
+        axes["run.tau"] = snap_taus(axes["run.tau"], run["save_dt"], span, fail)
+        run["tau"] = float(axes["run.tau"][0])
+
+    output = raw.get("output", {}).get("path")
+    study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
+                  ensemble=ens, axes=axes,
+                  output=None if output is None else path.parent / output)  # fmt: skip
+
+    # every grid point must build (law shapes, time grid): try them all, cheaply
+    for _, values in study.points():
+        label = ", ".join(f"{k} = {v:g}" for k, v in values.items()) or "the base point"
+        try:
+            s = study.setup(values)
+            bound_law = s["law"]
+            bound_law.bind(model) if bound_law.is_constant else None
+            _check_time_grid(s["tau"], s["t_end"] - model.t0, s["save_dt"])
+        except (LawError, SchemeError, ValueError, IndexError) as exc:
+            raise StudyError(f"{where}: at {label}: {exc}") from None
+    return study
+
+
+def _typed(val, kind, key, fail):
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    for k in kinds:
+        if k is float and isinstance(val, (int, float)) and not isinstance(val, bool):
+            return float(val)
+        if k is int and isinstance(val, int) and not isinstance(val, bool):
+            return val
+        if k in (str, dict, list) and isinstance(val, k):
+            return val
+    names = " or ".join({float: "a number", int: "an integer", str: "a string",
+                         dict: "a table", list: "an array"}[k] for k in kinds)  # fmt: skip
+    fail(key, f"must be {names}, got {type(val).__name__} {val!r}")
+
+
+def _canonical(name: str, model: Model, law: dict, scheme: dict, fail) -> str:
+    if _MATRIX_ENTRY.match(name):
+        if law["kind"] != "matrix":
+            fail(f"[sweep] {name}", "matrix entries can only be swept with [law] kind = 'matrix'")
+        m = _MATRIX_ENTRY.match(name)
+        return f"law.A[{m.group(1)},{m.group(2)}]"
+    if "." in name:
+        section, key = name.split(".", 1)
+        ok = {"run": key in _SWEEPABLE_RUN, "law": key in _LAW_KEYS[law["kind"]] - {"A", "L"},
+              "scheme": key in ("a", "sigma"), "model": key in model.params}.get(section)
+        if not ok:
+            fail(f"[sweep] {name}", _sweepable_list(model, law))
+        return name
+    hits = []
+    if name in _SWEEPABLE_RUN:
+        hits.append(f"run.{name}")
+    if name in _LAW_KEYS[law["kind"]] - {"A", "L"}:
+        hits.append(f"law.{name}")
+    if name in ("a", "sigma"):
+        hits.append(f"scheme.{name}")
+    if name in model.params:
+        hits.append(f"model.{name}")
+    if not hits:
+        fail(f"[sweep] {name}", _sweepable_list(model, law))
+    if len(hits) > 1:
+        fail(f"[sweep] {name}", f"ambiguous: write one of {', '.join(hits)}")
+    return hits[0]
+
+
+def _sweepable_list(model, law) -> str:
+    names = ["tau", *sorted(_LAW_KEYS[law["kind"]] - {"A", "L"}), "a", "sigma",
+             *model.params]  # fmt: skip
+    if law["kind"] == "matrix":
+        names.append("A[i,j]")
+    return f"not a sweepable parameter; sweepable here: {', '.join(names)}"
+
+
+def _axis_values(spec, key, fail) -> np.ndarray:
+    if isinstance(spec, list):
+        if not spec or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                               for v in spec):  # fmt: skip
+            fail(key, f"must be a non-empty array of numbers, got {spec!r}")
+        values = np.array(spec, dtype=float)
+    elif isinstance(spec, dict):
+        if len(spec) != 1 or next(iter(spec)) not in ("linspace", "logspace"):
+            fail(key, f"must be an array or {{ linspace = [a, b, n] }} / "
+                 f"{{ logspace = [a, b, n] }}, got {spec!r}")  # fmt: skip
+        how, args = next(iter(spec.items()))
+        if not (isinstance(args, list) and len(args) == 3 and isinstance(args[2], int)
+                and args[2] >= 1 and all(isinstance(a, (int, float)) for a in args[:2])):
+            fail(key, f"{how} needs [start, stop, count] with an integer count, got {args!r}")
+        a, b, n = float(args[0]), float(args[1]), args[2]
+        if how == "logspace":
+            if not (a > 0 and b > 0):
+                fail(key, f"logspace needs positive ends (the values themselves), got {args!r}")
+            values = np.geomspace(a, b, n)
+        else:
+            values = np.linspace(a, b, n)
+    else:
+        fail(key, f"must be an array or a linspace/logspace table, got {spec!r}")
+    if not np.all(np.isfinite(values)):
+        fail(key, "values must be finite")
+    if len(np.unique(values)) != len(values):
+        fail(key, f"values repeat: {values.tolist()}")
+    return values
+
+
+def snap_taus(taus, save_dt: float, span: float, fail=None) -> np.ndarray:
+    """Step sizes moved onto the common sample grid of a τ sweep.
+
+    Every grid point stores the residual at the same times ``t0 + j·save_dt``, so each τ
+    becomes ``save_dt / K`` (``K = ⌈save_dt/τ⌉``: never larger than asked) when
+    ``τ ≤ save_dt``, and ``L·save_dt`` (the largest ``L ≤ τ/save_dt`` that divides the
+    number of samples; samples between steps are NaN) when it is larger.
+    """
+    nsave = round(span / save_dt)
+    if abs(nsave * save_dt - span) > 1e-9 * span:
+        msg = f"t_end - t0 = {span:g} must be a whole multiple of save_dt = {save_dt:g}"
+        if fail:
+            fail("[run] save_dt", msg)
+        raise ValueError(msg)
+    out = []
+    for tau in taus:
+        if tau <= save_dt * (1 + 1e-12):
+            out.append(save_dt / math.ceil(save_dt / tau - 1e-9))
+        else:
+            L = max(1, math.floor(tau / save_dt + 1e-9))
+            while nsave % L:
+                L -= 1
+            out.append(L * save_dt)
+    out = np.array(out)
+    if len(np.unique(out)) != len(out) and fail:
+        fail("[sweep] tau", f"values {np.asarray(taus).tolist()} land on repeated step sizes "
+             f"{out.tolist()} on the sample grid save_dt = {save_dt:g}; use fewer values or "
+             "a larger save_dt")  # fmt: skip
+    return out
+
+
+def _check_axis(canon, values, model, law, key, fail):
+    positive = {"run.tau", "law.omega", "law.k"}
+    if canon in positive and not np.all(values > 0):
+        fail(key, f"values must be positive, got {values.tolist()}")
+    if canon == "law.xi" and not np.all(values >= 0):
+        fail(key, f"values must be non-negative, got {values.tolist()}")
+
+
+def _check_time_grid(tau, span, save_dt):
+    from ._integrate import _whole_multiple
+
+    if not span > 0:
+        raise ValueError(f"t_end must be after t0, got a span of {span:g}")
+    nsteps = _whole_multiple(span, tau, "t_end - t0", "tau")
+    if save_dt is not None:
+        every = _whole_multiple(save_dt, tau, "save_dt", "tau")
+        if nsteps % every:
+            raise ValueError(f"t_end - t0 = {span:g} must be a whole multiple of save_dt")

@@ -1,0 +1,160 @@
+"""Study files: validation before anything compiles, grids, and ``stabdae theory``."""
+
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+import pytest
+
+from stabdae._cli import main
+from stabdae._study import StudyError, load_study
+
+BASE = """
+[model]
+file = "pendulum"
+
+[law]
+kind = "baumgarte"
+omega = 10.0
+xi = 1.0
+
+[scheme]
+name = "rk2"
+
+[run]
+t_end = 1.0
+tau = 1e-3
+save_dt = 0.05
+
+[ensemble]
+members = 16
+radius = [1e-6, 1e-3]
+seed = 1
+"""
+
+
+def write(tmp_path, text, name="study.toml"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_a_valid_study_and_its_grid(tmp_path):
+    path = write(tmp_path, BASE + """
+[sweep]
+tau = [1e-3, 2e-3, 5e-3]
+omega = [5.0, 10.0]
+"g" = [9.81, 1.62]
+""")  # fmt: skip
+    study = load_study(path)
+    assert list(study.axes) == ["run.tau", "law.omega", "model.g"]
+    assert study.shape == (3, 2, 2) and study.size == 12
+    idx, values = list(study.points())[-1]
+    assert idx == (2, 1, 1) and values == {"run.tau": 5e-3, "law.omega": 10.0, "model.g": 1.62}
+    s = study.setup(values)
+    assert s["tau"] == 5e-3 and s["params"]["g"] == 1.62
+    assert s["law"].A(study.model)[0, 0] == -100.0
+
+
+def test_tau_sweep_snaps_onto_the_sample_grid(tmp_path):
+    path = write(tmp_path, BASE + "\n[sweep]\ntau = { logspace = [1e-4, 1e-1, 7] }\n")
+    study = load_study(path)
+    taus = study.axes["run.tau"]
+    save_dt = 0.05
+    for asked, got in zip(np.geomspace(1e-4, 1e-1, 7), taus):
+        if asked <= save_dt:
+            assert got <= asked and save_dt / got == pytest.approx(round(save_dt / got))
+        else:
+            assert got / save_dt == pytest.approx(round(got / save_dt)) and got <= asked
+    assert study.setup({"run.tau": taus[-1]})["stride"] == 2  # τ = 0.1 spans 2 samples
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        # unknown keys and sections
+        (("[run]", "[run]\nstep = 3"), r"\[run\] step: unknown key; known: t_end, tau"),
+        (("[scheme]", "[schemes]"), r"\[schemes\]: unknown section"),
+        (("xi = 1.0", "xi = 1.0\nL = [[1.0]]"), r"\[law\] L: not a parameter of the 'baumgarte'"),
+        (("xi = 1.0", "xi = 1.0\nk = 3.0"), r"\[law\] k: model 'pendulum' has no nonholonomic"),
+        # wrong types
+        (("tau = 1e-3", 'tau = "small"'), r"\[run\] tau: must be a number, got str 'small'"),
+        (("members = 16", "members = 16.5"), r"\[ensemble\] members: must be an integer"),
+        (("seed = 1", "seed = true"), r"\[ensemble\] seed: must be an integer, got bool"),
+        # impossible values
+        (("tau = 1e-3", "tau = -1e-3"), r"\[run\] tau: must be positive and finite, got -0.001"),
+        (("radius = [1e-6, 1e-3]", "radius = [1e-3, 1e-6]"),
+         r"\[ensemble\] radius: needs 0 < low <= high"),
+        (("members = 16", "members = 0"), r"\[ensemble\] members: must be at least 1, got 0"),
+        (("omega = 10.0", "omega = 0.0"), r"\[law\] omega: must be positive, got 0.0"),
+        (("tau = 1e-3", "tau = 3e-3"), r"at the base point: .*must be a whole multiple"),
+        (("kind = \"baumgarte\"", "kind = \"magic\""), r"\[law\] kind: unknown law 'magic'"),
+        (("name = \"rk2\"", "name = \"rk7\""), r"\[scheme\] name: unknown scheme 'rk7'"),
+        (('file = "pendulum"', 'file = "nowhere.py"'), r"\[model\] file: no such model file"),
+        (('file = "pendulum"', 'file = "pendulum"\nparams = { G = 1.0 }'),
+         r"\[model\] params.G: model 'pendulum' has no parameter 'G'; its parameters: g, l"),
+        (("t_end = 1.0\n", ""), r"\[run\] t_end: missing \(required\)"),
+    ],
+)
+def test_validation_names_the_file_and_key(tmp_path, edit, message):
+    old, new = edit
+    assert old in BASE
+    path = write(tmp_path, BASE.replace(old, new, 1))
+    with pytest.raises(StudyError, match=r"^study.toml: " + message):
+        load_study(path)
+
+
+@pytest.mark.parametrize(
+    "sweep, message",
+    [
+        ("speed = [1.0]", r"\[sweep\] speed: not a sweepable parameter; sweepable here: tau"),
+        ("omega = []", r"\[sweep\] omega: must be a non-empty array of numbers"),
+        ("omega = [1.0, -2.0]", r"\[sweep\] omega: values must be positive"),
+        ("omega = { logspace = [0.0, 1.0, 3] }", r"logspace needs positive ends"),
+        ("omega = { range = [1, 2] }", r"must be an array or \{ linspace"),
+        ("omega = { linspace = [1.0, 2.0, 2.5] }", r"needs \[start, stop, count\]"),
+        ('"A[0,0]" = [1.0]', r"matrix entries can only be swept with \[law\] kind = 'matrix'"),
+        ("tau = [1e-3, 1.01e-3]", r"land on repeated step sizes"),
+    ],
+)
+def test_sweep_validation(tmp_path, sweep, message):
+    path = write(tmp_path, BASE + "\n[sweep]\n" + sweep + "\n")
+    with pytest.raises(StudyError, match=message):
+        load_study(path)
+
+
+def test_ambiguous_sweep_name_asks_for_a_prefix(tmp_path):
+    text = BASE.replace('file = "pendulum"', 'file = "chaplygin_sleigh"').replace(
+        'kind = "baumgarte"\nomega = 10.0\nxi = 1.0', 'kind = "theorem5"\nk = 2.0'
+    )
+    # the sleigh has no parameter k, so "k" is the law's gain; "m" is the sleigh's mass
+    study = load_study(write(tmp_path, text + "\n[sweep]\nk = [1.0, 2.0]\nm = [1.0, 2.0]\n"))
+    assert list(study.axes) == ["law.k", "model.m"]
+
+
+def test_matrix_law_entries_sweep(tmp_path):
+    text = BASE.replace('kind = "baumgarte"\nomega = 10.0\nxi = 1.0',
+                        'kind = "matrix"\nA = [[-100.0, -20.0]]')  # fmt: skip
+    study = load_study(write(tmp_path, text + '\n[sweep]\n"A[0,1]" = [-20.0, -5.0]\n'))
+    law = study.setup({"law.A[0,1]": -5.0})["law"]
+    np.testing.assert_array_equal(law.A(study.model), [[-100.0, -5.0]])
+    bad = write(tmp_path, text + '\n[sweep]\n"A[3,0]" = [1.0]\n', "bad.toml")
+    with pytest.raises(StudyError, match=r"at law.A\[3,0\] = 1: index 3 is out of bounds"):
+        load_study(bad)
+
+
+def test_theory_command_prints_the_table(tmp_path, capsys):
+    path = write(tmp_path, BASE + "\n[sweep]\ntau = [0.01, 0.05]\n")
+    assert main(["theory", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "Theorem 3: eigenvalues of Ã: -10" in out
+    assert "largest tau for midpoint: spectral 0.2, max_norm 0, two_norm 0" in out
+    rows = [line.split() for line in out.splitlines() if line.strip().startswith(("0.01", "0.05"))]
+    assert len(rows) == 2 and all(r[4] == "yes" for r in rows)
+
+
+def test_cli_reports_study_errors(tmp_path, capsys):
+    path = write(tmp_path, BASE.replace("tau = 1e-3", "tau = -1.0"))
+    assert main(["theory", str(path)]) == 2
+    assert "study.toml: [run] tau: must be positive" in capsys.readouterr().err
