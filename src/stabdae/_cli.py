@@ -118,6 +118,33 @@ def _cmd_theory(args) -> int:
     return 0
 
 
+def _cmd_run(args) -> int:
+    from ._run import run_study
+    from ._study import load_study
+
+    study = load_study(args.study, members=args.members)
+    out = run_study(study, args.output, force=args.force, workers=args.workers,
+                    scheduler=args.scheduler, progress=not args.quiet,
+                    threads=args.threads)  # fmt: skip
+    if not args.no_plots:
+        try:
+            from .plots import plot_dataset
+        except ImportError:
+            print("pictures skipped: matplotlib is not installed (pip install 'stabdae[plots]')")
+        else:
+            for path in plot_dataset(out):
+                print(f"picture written to {path}")
+    return 0
+
+
+def _cmd_plot(args) -> int:
+    from .plots import plot_dataset
+
+    for path in plot_dataset(args.dataset, args.output):
+        print(f"picture written to {path}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="stabdae",
@@ -157,6 +184,25 @@ def main(argv: list[str] | None = None) -> int:
                          "running the ensembles")  # fmt: skip
     thy.add_argument("study", help="study file (TOML)")
     thy.set_defaults(func=_cmd_theory)
+
+    run = sub.add_parser("run", help="run a study: ensembles over its grid, dataset and "
+                         "pictures")  # fmt: skip
+    run.add_argument("study", help="study file (TOML)")
+    run.add_argument("-o", "--output", help="NetCDF output (default: the study's [output])")
+    run.add_argument("--members", type=int, help="override [ensemble] members")
+    run.add_argument("--force", action="store_true", help="overwrite an existing output")
+    grp = run.add_mutually_exclusive_group()
+    grp.add_argument("--workers", type=int, help="start a local dask cluster of N workers")
+    grp.add_argument("--scheduler", help="address of a running dask scheduler")
+    run.add_argument("--threads", type=int, help="threads per ensemble (default: all cores)")
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.add_argument("--no-plots", action="store_true", help="do not write pictures")
+    run.set_defaults(func=_cmd_run)
+
+    plt_ = sub.add_parser("plot", help="pictures of a study or ensemble dataset")
+    plt_.add_argument("dataset", help="NetCDF written by stabdae run")
+    plt_.add_argument("-o", "--output", help="folder or file stem for the pictures")
+    plt_.set_defaults(func=_cmd_plot)
 
     args = parser.parse_args(argv)
     try:

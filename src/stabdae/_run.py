@@ -1,0 +1,267 @@
+"""``stabdae run``: a study's grid of ensembles, resumable and lossless.
+
+Each grid point is one :func:`stabdae.ensemble` with the study's seed (the same α⁰ targets
+at every point: common random numbers, so that differences across the grid are the
+parameters' and not the sample's).  Its dataset is written, atomically, to
+``OUT.nc.parts/point-<i>.nc`` as soon as it is done; a run that is killed and started
+again with the same command skips the points already there.  When every point is in,
+they are combined into ``OUT.nc`` (written atomically) and the parts are removed.
+Nothing depends on where a point ran (in-process, or on dask workers), so the dataset is
+the same either way.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from ._dataset import write_netcdf
+from ._study import Study, load_study
+
+__all__ = ["run_study", "run_point", "combine"]
+
+#: attributes that say when/how fast, not what: left out of the study dataset
+_VOLATILE = ("wall_sample_s", "wall_integrate_s", "wall_fit_s", "created_at", "history",
+             "threads")  # fmt: skip
+
+
+def axis_name(canon: str, all_names) -> str:
+    """Dataset name of a sweep axis: ``tau``, ``omega``, ``g``, ``A_0_1`` (prefixed with
+    the section where two sections share a key)."""
+    section, key = canon.split(".", 1)
+    key = key.replace("[", "_").replace(",", "_").replace("]", "")
+    keys = [c.split(".", 1)[1] for c in all_names]
+    if keys.count(canon.split(".", 1)[1]) > 1:
+        return f"{section}_{key}"
+    return key
+
+
+def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dataset:
+    """The ensemble at one grid point, on the study's common sample grid."""
+    from ._ensemble import ensemble
+
+    s = study.setup(values)
+    ens = study.ensemble
+    ds = ensemble(study.model, s["law"], s["scheme"], s["tau"], s["t_end"],
+                  members=ens["members"], radius=tuple(ens["radius"]), seed=ens["seed"],
+                  save_dt=s["save_dt"], params=s["params"], epsilon=s["epsilon"],
+                  divergence=s["divergence"], block=ens["block"], threads=threads,
+                  progress=progress)  # fmt: skip
+    if s["stride"] > 1:  # a step spans several samples: NaN between the steps
+        stride = s["stride"]
+        t0 = float(ds.time[0])
+        nsave = (ds.sizes["time"] - 1) * stride + 1
+        times = t0 + (np.arange(nsave) / stride) * float(ds.time[1] - ds.time[0])
+        full = np.full((ds.sizes["member"], nsave), np.nan, dtype=ds.residual_norm.dtype)
+        full[:, ::stride] = ds.residual_norm.values
+        attrs = ds.residual_norm.attrs
+        ds = ds.drop_vars("residual_norm").assign_coords(time=("time", times, ds.time.attrs))
+        ds["residual_norm"] = (("member", "time"), full, attrs)
+    for key in _VOLATILE:
+        ds.attrs.pop(key, None)
+    return ds
+
+
+def _fingerprint(study: Study) -> str:
+    h = hashlib.sha256(study.path.read_bytes())
+    h.update(json.dumps(study.ensemble, sort_keys=True).encode())
+    from ._version import __version__
+
+    h.update(__version__.encode())
+    return h.hexdigest()
+
+
+def run_study(study, output=None, *, force: bool = False, members: int | None = None,
+              workers: int | None = None, scheduler: str | None = None, progress: bool = True,
+              threads: int | None = None, log=print) -> Path:  # fmt: skip
+    """Run every grid point of ``study`` (a :class:`Study` or a path) and write the dataset.
+
+    Returns the output path.  Raises ``FileExistsError`` when the output exists and
+    ``force`` is false.  Resumes from ``OUTPUT.parts`` when it belongs to the same study
+    file and ensemble settings (else an error; ``force`` starts over).
+    """
+    if not isinstance(study, Study):
+        study = load_study(study, members=members)
+    out = Path(output) if output is not None else study.output
+    if out is None:
+        out = Path("results") / f"{study.path.stem}.nc"
+    if out.exists() and not force:
+        raise FileExistsError(f"{out} exists; pass --force to overwrite it")
+    parts = out.with_name(out.name + ".parts")
+    stamp = _fingerprint(study)
+    manifest = parts / "study.json"
+    if parts.exists():
+        old = json.loads(manifest.read_text()).get("fingerprint") if manifest.exists() else None
+        if old != stamp:
+            if not force:
+                raise FileExistsError(
+                    f"{parts} holds a run of a different study or ensemble; pass --force to "
+                    "discard it"
+                )
+            shutil.rmtree(parts)
+    parts.mkdir(parents=True, exist_ok=True)
+    manifest.write_text(json.dumps({"fingerprint": stamp, "study": str(study.path)}))
+
+    points = list(study.points())
+    todo = [(i, values) for i, (_, values) in enumerate(points)
+            if not (parts / f"point-{i}.nc").exists()]  # fmt: skip
+    log(study.describe())
+    if len(todo) < len(points):
+        log(f"resuming: {len(points) - len(todo)} of {len(points)} grid points already done")
+    start = time.perf_counter()
+    bar = _Progress(len(points), len(points) - len(todo), study.ensemble["members"], progress)
+    try:
+        if workers or scheduler:
+            _run_dask(study, todo, parts, workers, scheduler, bar)
+        else:
+            for i, values in todo:
+                ds = run_point(study, values, threads=threads, progress=bar.members)
+                write_netcdf(ds, parts / f"point-{i}.nc")
+                bar.point_done()
+    finally:
+        bar.close()
+    ds = combine(study, parts, len(points))
+    ds.attrs["wall_run_s"] = time.perf_counter() - start
+    write_netcdf(ds, out)
+    shutil.rmtree(parts)
+    log(summary(ds))
+    log(f"dataset written to {out}")
+    return out
+
+
+def _run_dask(study, todo, parts, workers, scheduler, bar):
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    if scheduler:
+        client, cluster = Client(scheduler), None
+    else:
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1,
+                               processes=True, dashboard_address=None)  # fmt: skip
+        client = Client(cluster)
+    try:
+        path, members = str(study.path), study.ensemble["members"]
+        futures = {client.submit(_remote_point, path, members, values, pure=False): i
+                   for i, values in todo}  # fmt: skip
+        for fut in as_completed(futures):
+            write_netcdf(fut.result(), parts / f"point-{futures[fut]}.nc")
+            bar.point_done()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _remote_point(path, members, values):
+    study = load_study(path, members=members)
+    return run_point(study, values, threads=1)
+
+
+def combine(study: Study, parts: Path, npoints: int) -> xr.Dataset:
+    """The study dataset from its per-point parts: every variable gains the sweep axes."""
+    names = list(study.axes)
+    pts = []
+    for i in range(npoints):
+        with xr.open_dataset(parts / f"point-{i}.nc") as f:
+            pts.append(f.load())
+    first = pts[0]
+    if not names:
+        ds = first
+    else:
+        dims = [axis_name(n, names) for n in names]
+        stacked = xr.concat(pts, dim="point", coords="minimal", compat="override",
+                            combine_attrs="drop_conflicts", join="override")  # fmt: skip
+        index = np.array([idx for idx, _ in study.points()])
+        ds = stacked.assign_coords(
+            {d: ("point", study.axes[n][index[:, k]]) for k, (n, d) in enumerate(zip(names, dims))}
+        )
+        if len(dims) == 1:
+            ds = ds.swap_dims(point=dims[0])
+        else:
+            ds = ds.set_index(point=dims).unstack("point")
+        ds = ds.transpose(*dims, ...)
+        for n, d in zip(names, dims):
+            ds[d].attrs.update(long_name=f"swept {n}", units=_axis_units(n))
+        for n in names:  # a swept value is a coordinate now, not an attribute
+            ds.attrs.pop(n.split(".", 1)[1], None)
+    for key in _VOLATILE:
+        ds.attrs.pop(key, None)
+    ds.attrs["study"] = study.path.name
+    ds.attrs["swept"] = ", ".join(names) if names else "nothing"
+    ds.attrs["created_at"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
+    return ds
+
+
+def _axis_units(canon: str) -> str:
+    return {"run.tau": "s", "law.omega": "s-1", "law.k": "s-1"}.get(canon, "1")
+
+
+def summary(ds: xr.Dataset) -> str:
+    """Per grid point: fraction bounded, δ*, median β beside the predictions."""
+    cols = [c for c in ("fraction_bounded", "stability_radius", "beta_median",
+                        "beta_theory_discrete", "spectral_radius", "norm_condition",
+                        "beta_theorem5_proven", "beta_theorem5_printed") if c in ds]  # fmt: skip
+    short = {"fraction_bounded": "bounded", "stability_radius": "delta*", "beta_median":
+             "beta_med", "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
+             "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
+             "beta_theorem5_printed": "b5_printed"}  # fmt: skip
+    dims = [d for d in ds["fraction_bounded"].dims]
+    flat = ds[cols].stack(point=dims) if dims else ds[cols].expand_dims(point=[0])
+    head = dims + [short[c] for c in cols]
+    rows = []
+    for i in range(flat.sizes["point"]):
+        row = [f"{float(flat[d].values[i]):.4g}" for d in dims]
+        for c in cols:
+            v = float(flat[c].values[i])
+            row.append(("yes" if v == 1 else "no") if c == "norm_condition" else f"{v:.4g}")
+        rows.append(row)
+    width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
+    lines = ["", "summary (bounded: fraction of members; delta*: stability radius; "
+             "beta_pred = -ln rho(R)/tau):"]  # fmt: skip
+    lines.append("  ".join(h.rjust(w) for h, w in zip(head, width)))
+    lines += ["  ".join(x.rjust(w) for x, w in zip(r, width)) for r in rows]
+    return "\n".join(lines)
+
+
+class _Progress:
+    """A progress bar over grid points and members (tqdm when installed, else a line on
+    stderr per point); silent when ``enabled`` is false."""
+
+    def __init__(self, points: int, done: int, members: int, enabled: bool):
+        self.points, self.done, self.members_total = points, done, members
+        self.enabled = enabled and points > 0
+        self._bar = None
+        if self.enabled:
+            try:
+                from tqdm import tqdm
+
+                self._bar = tqdm(total=points * members, initial=done * members,
+                                 unit="member", desc="stabdae run", file=sys.stderr,
+                                 dynamic_ncols=True)  # fmt: skip
+            except ImportError:
+                self._bar = None
+        self._last = 0
+
+    def members(self, done: int, total: int):
+        if self._bar is not None:
+            self._bar.update(done - self._last)
+            self._last = done
+
+    def point_done(self):
+        self.done += 1
+        if self._bar is not None:
+            self._bar.update(self.members_total - self._last)
+            self._bar.set_postfix_str(f"grid point {self.done}/{self.points}")
+        elif self.enabled:
+            print(f"stabdae run: grid point {self.done}/{self.points} done", file=sys.stderr)
+        self._last = 0
+
+    def close(self):
+        if self._bar is not None:
+            self._bar.close()

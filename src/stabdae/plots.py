@@ -1,0 +1,280 @@
+"""Pictures of a study dataset (``stabdae plot OUT.nc``; written by ``stabdae run``).
+
+* ``<stem>_stability.png`` — the stability map: ``fraction_bounded`` over the first two
+  swept axes, with the theory's boundaries drawn over it (``ρ(R(τÃ)) = 1`` and the
+  weighted-norm condition of Theorems 6/7); with one swept axis, a curve.
+* ``<stem>_decay.png`` — residual decay of sampled members at one grid point, each with
+  its fitted ``γ e^{−βt}`` and the theory's rate.
+* ``<stem>_beta.png`` — median fitted ``β`` against the predicted one at every grid point.
+
+Needs matplotlib (``pip install 'stabdae[plots]'``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+__all__ = ["plot_dataset", "stability_map", "decay_curves", "beta_comparison"]
+
+_GRID_VARS = ("fraction_bounded",)
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _sweep_dims(ds: xr.Dataset) -> list[str]:
+    return [d for d in ds["fraction_bounded"].dims]
+
+
+def _label(ds, dim) -> str:
+    units = ds[dim].attrs.get("units", "")
+    names = {"tau": "step size τ", "omega": "Baumgarte ω", "xi": "damping ratio ξ",
+             "k": "gain k"}  # fmt: skip
+    return f"{names.get(dim, dim)}" + (f" [{units}]" if units not in ("", "1") else "")
+
+
+def _is_log(values) -> bool:
+    v = np.asarray(values, dtype=float)
+    return bool(len(v) >= 3 and np.all(v > 0) and v.max() / v.min() >= 20)
+
+
+def _edges(v, log):
+    v = np.asarray(v, dtype=float)
+    if len(v) == 1:
+        return np.array([v[0] * 0.9, v[0] * 1.1]) if log else np.array([v[0] - 0.5, v[0] + 0.5])
+    w = np.log(v) if log else v
+    mid = 0.5 * (w[1:] + w[:-1])
+    e = np.concatenate([[w[0] - (mid[0] - w[0])], mid, [w[-1] + (w[-1] - mid[-1])]])
+    return np.exp(e) if log else e
+
+
+def _outline(ax, mask, xe, ye, **style):
+    """Draw the cell edges between cells where ``mask`` (ny × nx) holds and where it does
+    not (or the border): the prediction exactly per grid cell, nothing interpolated."""
+    ny, nx = mask.shape
+    segs = []
+    for i in range(ny):
+        for j in range(nx):
+            if not mask[i, j]:
+                continue
+            if j == 0 or not mask[i, j - 1]:
+                segs.append(((xe[j], ye[i]), (xe[j], ye[i + 1])))
+            if j == nx - 1 or not mask[i, j + 1]:
+                segs.append(((xe[j + 1], ye[i]), (xe[j + 1], ye[i + 1])))
+            if i == 0 or not mask[i - 1, j]:
+                segs.append(((xe[j], ye[i]), (xe[j + 1], ye[i])))
+            if i == ny - 1 or not mask[i + 1, j]:
+                segs.append(((xe[j], ye[i + 1]), (xe[j + 1], ye[i + 1])))
+    if not segs:
+        return None
+    from matplotlib.collections import LineCollection
+
+    kw = {"colors": style.get("color"), "linewidths": style.get("lw", 1.5),
+          "linestyles": style.get("ls", "-")}  # fmt: skip
+    ax.add_collection(LineCollection(segs, **kw))
+    from matplotlib.lines import Line2D
+
+    return Line2D([], [], color=style.get("color"), lw=style.get("lw", 1.5),
+                  ls=style.get("ls", "-"))
+
+
+def _first_of_others(ds, keep):
+    sel = {d: 0 for d in _sweep_dims(ds) if d not in keep}
+    note = ", ".join(f"{d} = {float(ds[d][0]):g}" for d in sel)
+    return ds.isel(sel), note
+
+
+def stability_map(ds: xr.Dataset, path: Path) -> Path:
+    plt = _plt()
+    dims = _sweep_dims(ds)
+    fig, ax = plt.subplots(figsize=(7.2, 5.2), constrained_layout=True)
+    title = f"{ds.attrs.get('model', '')}: {ds.attrs.get('law', '')} law, " \
+            f"{ds.attrs.get('scheme', '')} — fraction of members bounded"  # fmt: skip
+    if len(dims) >= 2:
+        xd, yd = dims[0], dims[1]
+        sub, note = _first_of_others(ds, (xd, yd))
+        x, y = sub[xd].values, sub[yd].values
+        xlog, ylog = _is_log(x), _is_log(y)
+        frac = sub["fraction_bounded"].transpose(yd, xd).values
+        mesh = ax.pcolormesh(_edges(x, xlog), _edges(y, ylog), frac, cmap="viridis",
+                             vmin=0, vmax=1, shading="flat")  # fmt: skip
+        fig.colorbar(mesh, ax=ax, label="fraction of members bounded (Definition 2)")
+        handles = []
+        xe, ye = _edges(x, xlog), _edges(y, ylog)
+        for var, style, label in (
+            ("spectral_radius", dict(color="white", lw=3.0), "ρ(R(τÃ)) < 1 (spectral radius)"),
+            ("norm_weighted", dict(color="orangered", lw=1.4, ls="--"),
+             "weighted-norm condition of Thms 6/7"),
+        ):  # fmt: skip
+            if var not in sub:
+                continue
+            holds = (sub[var].transpose(yd, xd).values < 1.0)
+            line = _outline(ax, holds, xe, ye, **style)
+            if line is not None:
+                handles.append((line, label))
+        if handles:
+            leg = ax.legend(*zip(*handles), loc="upper right", framealpha=0.9, fontsize=8.5)
+            leg.set_title("theory: holds inside the outline", prop={"size": 8.5})
+        ax.set_xscale("log" if xlog else "linear")
+        ax.set_yscale("log" if ylog else "linear")
+        ax.set_xlabel(_label(ds, xd))
+        ax.set_ylabel(_label(ds, yd))
+        if note:
+            title += f"\n(at {note})"
+    elif len(dims) == 1:
+        xd = dims[0]
+        x = ds[xd].values
+        ax.plot(x, ds["fraction_bounded"].values, "o-", label="fraction bounded (measured)")
+        if "spectral_radius" in ds:
+            rho = ds["spectral_radius"].values
+            ax.plot(x, np.minimum(rho, 2.0), "s--", color="gray", label="ρ(R(τÃ)) (theory)")
+            ax.axhline(1.0, color="gray", lw=0.8)
+        ax.set_xscale("log" if _is_log(x) else "linear")
+        ax.set_xlabel(_label(ds, xd))
+        ax.set_ylim(-0.05, 2.05)
+        ax.legend(fontsize=9)
+    else:
+        frac = float(ds.fraction_bounded)
+        ax.text(0.5, 0.5, f"nothing swept: fraction bounded = {frac:.3g}", ha="center",
+                transform=ax.transAxes)  # fmt: skip
+    ax.set_title(title, fontsize=10)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    return path
+
+
+def _pick_point(ds):
+    """The grid point that shows decay best: every member bounded and the longest
+    transient above the truncation floor."""
+    dims = _sweep_dims(ds)
+    if not dims:
+        return {}
+    frac = ds["fraction_bounded"]
+    # samples of the transient above 10x the floor, median over the upper half of members
+    above = (ds["residual_norm"] > 10.0 * ds["residual_floor"]).sum("time")
+    big = ds["alpha0_norm"] >= ds["alpha0_norm"].median("member")
+    visible = above.where(big).median("member")
+    score = xr.where(frac >= 0.99, visible.fillna(-1.0), -np.inf)
+    if not np.isfinite(score.values).any():
+        score = frac
+    idx = np.unravel_index(int(np.argmax(score.values)), score.shape)
+    return {d: int(i) for d, i in zip(score.dims, idx)}
+
+
+def decay_curves(ds: xr.Dataset, path: Path, members: int = 12) -> Path:
+    plt = _plt()
+    point = _pick_point(ds)
+    sub = ds.isel(point)
+    t = sub["time"].values - sub["time"].values[0]
+    fig, ax = plt.subplots(figsize=(7.2, 5.0), constrained_layout=True)
+    # members spread over the upper half of the perturbation sizes: the ones whose decay
+    # is visible above the truncation floor
+    order = np.argsort(-sub["alpha0_norm"].values)
+    top = order[: max(1, len(order) // 2)]
+    chosen = top[np.linspace(0, len(top) - 1, min(members, len(top))).astype(int)]
+    colors = plt.cm.viridis(np.linspace(0, 0.9, len(chosen)))
+    for c, j in zip(colors, chosen):
+        y = sub["residual_norm"].values[j].astype(float)
+        ok = np.isfinite(y)
+        ax.semilogy(t[ok], y[ok], "-", color=c, lw=1.1)
+        b, g = float(sub["beta"].values[j]), float(sub["gamma"].values[j])
+        if np.isfinite(b) and np.isfinite(g):
+            ax.semilogy(t, g * np.exp(-b * t), ":", color=c, lw=0.9)
+    if "beta_theory_discrete" in sub and np.isfinite(float(sub["beta_theory_discrete"])):
+        bd = float(sub["beta_theory_discrete"])
+        a0 = float(np.nanmax(sub["alpha0_norm"].values))
+        ax.semilogy(t, a0 * np.exp(-bd * t), "k--", lw=1.6,
+                    label=f"theory: slope −ln ρ(R)/τ = {bd:.4g} s⁻¹")  # fmt: skip
+    if "beta_theorem5_proven" in sub:
+        for var, st, name in (("beta_theorem5_proven", "k--", "proven"),
+                              ("beta_theorem5_printed", "r--", "printed")):  # fmt: skip
+            b = float(sub[var])
+            a0 = float(np.nanmax(sub["gamma_theorem5"].values))
+            ax.semilogy(t, a0 * np.exp(-b * t), st, lw=1.4,
+                        label=f"Theorem 5 bound, {name} β = {b:.4g} s⁻¹")  # fmt: skip
+    data = sub["residual_norm"].values[chosen].astype(float)
+    data = data[np.isfinite(data) & (data > 0)]
+    if data.size:
+        ax.set_ylim(0.3 * data.min(), 3.0 * data.max())
+    ax.plot([], [], "-", color="gray", label="‖g(t)‖∞ of a member")
+    ax.plot([], [], ":", color="gray", label="its fitted γ·exp(−βt)")
+    ax.set_xlabel("t − t₀ [s]")
+    ax.set_ylabel("constraint residual ‖g‖∞")
+    where = ", ".join(f"{d} = {float(sub[d]):g}" for d in point) or "the study"
+    ax.set_title(f"{ds.attrs.get('model', '')}: residual decay of {len(chosen)} members "
+                 f"at {where}\n(median fitted β = {float(sub['beta_median']):.4g} s⁻¹; "
+                 "curves level off at the scheme's truncation floor)", fontsize=10)  # fmt: skip
+    ax.legend(fontsize=8.5, loc="lower left")
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    return path
+
+
+def beta_comparison(ds: xr.Dataset, path: Path) -> Path:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(5.8, 5.4), constrained_layout=True)
+    meas = ds["beta_median"].values.ravel()
+    drew = False
+    for var, marker, label in (("beta_theory_discrete", "o", "−ln ρ(R(τÃ))/τ (discrete)"),
+                               ("beta_theory", "x", "−max Re λ(Ã) (continuous, Thm 3)"),
+                               ("beta_theorem5_proven", "s", "Theorem 5, proven"),
+                               ("beta_theorem5_printed", "^", "Theorem 5, printed")):  # fmt: skip
+        if var not in ds:
+            continue
+        pred = np.broadcast_to(ds[var].values, ds["beta_median"].shape).ravel()
+        ok = np.isfinite(pred) & np.isfinite(meas) & (pred > 0) & (meas > 0)
+        if ok.any():
+            ax.loglog(pred[ok], meas[ok], marker, ms=6, mfc="none", label=label)
+            drew = True
+    if drew:
+        lo, hi = ax.get_xlim()
+        lo2, hi2 = ax.get_ylim()
+        lo, hi = min(lo, lo2), max(hi, hi2)
+        ax.plot([lo, hi], [lo, hi], "k-", lw=0.8, label="measured = predicted")
+        ax.set_xlim(lo, hi)
+        ax.set_ylim(lo, hi)
+        ax.legend(fontsize=8.5)
+    else:
+        ax.text(0.5, 0.5, "no grid point with a fitted β\n(run longer, or smaller residual "
+                "floor)", ha="center", va="center", transform=ax.transAxes)  # fmt: skip
+    ax.set_xlabel("predicted decay rate β [s⁻¹]")
+    ax.set_ylabel("measured median β [s⁻¹]")
+    ax.set_title(f"{ds.attrs.get('model', '')}: measured against predicted β\n"
+                 "(one marker per grid point)", fontsize=10)  # fmt: skip
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    return path
+
+
+def plot_dataset(dataset, output=None) -> list[Path]:
+    """Write the three pictures for a dataset (a path or an open ``xarray.Dataset``)."""
+    if isinstance(dataset, xr.Dataset):
+        ds, src = dataset, None
+    else:
+        src = Path(dataset)
+        if not src.is_file():
+            raise FileNotFoundError(f"stabdae plot: no such dataset: {src}")
+        ds = xr.open_dataset(src).load()
+    if "fraction_bounded" not in ds:
+        raise ValueError("stabdae plot: the dataset has no fraction_bounded; it is not an "
+                         "ensemble or study dataset")  # fmt: skip
+    if output is None:
+        stem = src.with_suffix("") if src is not None else Path("stabdae")
+    else:
+        out = Path(output)
+        stem = out / (src.stem if src else "stabdae") if out.is_dir() else out.with_suffix("")
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    return [
+        stability_map(ds, Path(f"{stem}_stability.png")),
+        decay_curves(ds, Path(f"{stem}_decay.png")),
+        beta_comparison(ds, Path(f"{stem}_beta.png")),
+    ]

@@ -1,0 +1,152 @@
+"""``stabdae run``: resume after SIGKILL, dask equality, no overwrite without --force,
+pictures."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from stabdae._cli import main
+from stabdae._run import run_study
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+
+STUDY = """
+[model]
+file = "pendulum"
+
+[law]
+kind = "baumgarte"
+omega = 10.0
+xi = 1.0
+
+[scheme]
+name = "rk2"
+
+[run]
+t_end = {t_end}
+tau = 1e-3
+save_dt = 0.05
+epsilon = 1.0
+
+[ensemble]
+members = {members}
+radius = [1e-6, 1e-3]
+seed = 3
+
+[sweep]
+tau = [5e-4, 1e-3, 0.01, 0.05, 0.1, 0.2]
+omega = [{omegas}]
+
+[output]
+path = "out/study.nc"
+"""
+
+
+def study_file(tmp_path, members=64, t_end=1.0, omegas="5.0, 30.0", name="study.toml"):
+    path = tmp_path / name
+    path.write_text(STUDY.format(members=members, t_end=t_end, omegas=omegas))
+    return path
+
+
+def same_data(a: xr.Dataset, b: xr.Dataset):
+    """Identical variables, coordinates and attributes, but for when it was made."""
+    for ds in (a, b):
+        for key in ("created_at", "wall_run_s", "history"):
+            ds.attrs.pop(key, None)
+    xr.testing.assert_identical(a, b)
+
+
+def test_run_writes_dataset_and_pictures_and_refuses_to_overwrite(tmp_path, capsys):
+    path = study_file(tmp_path)
+    assert main(["run", str(path), "--quiet"]) == 0
+    out = tmp_path / "out" / "study.nc"
+    printed = capsys.readouterr().out
+    assert "summary" in printed and f"dataset written to {out}" in printed
+    ds = xr.open_dataset(out)
+    assert ds.fraction_bounded.dims == ("tau", "omega")
+    assert ds.residual_norm.dims == ("tau", "omega", "member", "time")
+    for name, var in ds.variables.items():
+        assert "units" in var.attrs and ("long_name" in var.attrs or name in ds.dims), name
+    # τ = 0.1, 0.2 are larger than save_dt: samples between their steps are NaN
+    r = ds.residual_norm.sel(tau=0.2, omega=5.0).values
+    assert np.isfinite(r[:, ::4]).all() and np.isnan(r[:, 1::4]).all()
+    # the stability boundary: τω < 2 for the midpoint rule at ξ = 1
+    pred = (ds.tau * ds.omega < 2.0).transpose("tau", "omega").values
+    np.testing.assert_array_equal(ds.spectral_radius.values < 1, pred)
+    for suffix in ("stability", "decay", "beta"):
+        png = tmp_path / "out" / f"study_{suffix}.png"
+        assert png.is_file() and png.stat().st_size > 10_000
+    before = out.stat().st_mtime_ns
+    assert main(["run", str(path), "--quiet"]) == 2
+    assert "exists; pass --force" in capsys.readouterr().err
+    assert out.stat().st_mtime_ns == before
+    assert main(["run", str(path), "--quiet", "--force", "--no-plots"]) == 0
+    same_data(xr.open_dataset(out).load(), ds.load())
+    # stabdae plot on the dataset
+    assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again_stability.png").is_file()
+
+
+def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
+    # slow enough per grid point (8192 members × 10⁴ steps) to be killed in the middle
+    path = study_file(tmp_path, members=8192, t_end=5.0, omegas="5.0")
+    (tmp_path / "ref").mkdir()
+    reference = run_study(study_file(tmp_path / "ref", members=8192, t_end=5.0, omegas="5.0"),
+                          progress=False, log=lambda *a: None)  # fmt: skip
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+    cmd = [sys.executable, "-m", "stabdae._cli", "run", str(path), "--quiet", "--no-plots"]
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parts = tmp_path / "out" / "study.nc.parts"
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(parts.glob("point-*.nc"))) < 2:
+        time.sleep(0.01)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    done = len(list(parts.glob("point-*.nc")))
+    assert 2 <= done < 6, done  # killed in the middle
+    assert not (tmp_path / "out" / "study.nc").exists()
+    out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
+    assert f"resuming: {done} of 6 grid points already done" in out.stdout
+    assert not parts.exists()
+    same_data(xr.open_dataset(tmp_path / "out" / "study.nc").load(),
+              xr.open_dataset(reference).load())  # fmt: skip
+
+
+def test_default_run_starts_no_cluster(tmp_path):
+    # (xarray's NetCDF writer imports dask.distributed, when installed, to look for a
+    # client; stabdae itself imports it only for --workers/--scheduler)
+    path = study_file(tmp_path, omegas="5.0")
+    code = textwrap.dedent(f"""
+        from stabdae._run import run_study
+        run_study({str(path)!r}, progress=False, log=lambda *a: None)
+        try:
+            import distributed
+            distributed.default_client()
+            print("a dask client")
+        except ImportError:
+            print("no client")
+        except ValueError:  # "No clients found"
+            print("no client")
+    """)
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         check=True)  # fmt: skip
+    assert out.stdout.strip() == "no client"
+
+
+def test_dask_cluster_gives_the_same_dataset(tmp_path):
+    pytest.importorskip("distributed")
+    path = study_file(tmp_path, omegas="5.0, 30.0")
+    local = run_study(path, tmp_path / "local.nc", progress=False, log=lambda *a: None)
+    dist = run_study(path, tmp_path / "dask.nc", workers=2, progress=False, log=lambda *a: None)
+    same_data(xr.open_dataset(dist).load(), xr.open_dataset(local).load())
