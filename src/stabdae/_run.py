@@ -128,12 +128,26 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     finally:
         bar.close()
     ds = combine(study, parts, len(points))
+    if not study.setup()["law"].is_constant:
+        ds = _with_path_theory(study, ds)
     ds.attrs["wall_run_s"] = time.perf_counter() - start
     write_netcdf(ds, out)
     shutil.rmtree(parts)
     log(summary(ds))
     log(f"dataset written to {out}")
     return out
+
+
+def _with_path_theory(study: Study, ds: xr.Dataset) -> xr.Dataset:
+    """State-dependent laws: the discrete conditions of Theorems 6/7 along the reference
+    trajectory at every grid point (:func:`stabdae.theory.for_study`)."""
+    from . import theory
+
+    th = theory.for_study(study)
+    names = list(study.axes)
+    th = th.rename({n: axis_name(n, names) for n in names})
+    keep = [v for v in th.data_vars if v.startswith("path_")]
+    return ds.assign({v: th[v].assign_coords({d: ds[d] for d in th[v].dims}) for v in keep})
 
 
 def _run_dask(study, todo, parts, workers, scheduler, bar):

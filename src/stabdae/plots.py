@@ -114,6 +114,10 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
             ("spectral_radius", dict(color="white", lw=3.0), "ρ(R(τÃ)) < 1 (spectral radius)"),
             ("norm_weighted", dict(color="orangered", lw=1.4, ls="--"),
              "weighted-norm condition of Thms 6/7"),
+            ("path_spectral_radius_max", dict(color="white", lw=3.0),
+             "max ρ(R_k) < 1 along the reference path"),
+            ("path_norm_weighted_max", dict(color="orangered", lw=1.4, ls="--"),
+             "weighted-norm condition along the path"),
         ):  # fmt: skip
             if var not in sub:
                 continue
