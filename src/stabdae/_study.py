@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -257,7 +258,8 @@ def load_study(path, *, members: int | None = None) -> Study:
     output = raw.get("output", {}).get("path")
     study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
                   ensemble=ens, axes=axes,
-                  output=None if output is None else path.parent / output)  # fmt: skip
+                  output=None if output is None
+                  else Path(os.path.normpath(path.parent / output)))  # fmt: skip
 
     # every grid point must build (law shapes, time grid): try them all, cheaply
     for _, values in study.points():
