@@ -40,6 +40,7 @@ def _cmd_integrate(args) -> int:
     from ._dataset import write_netcdf
     from ._loading import load_model
     from ._schemes import as_scheme
+    from .theory import step_matrix
 
     model = load_model(args.model)
     p = model.param_vector(_params(args.param))
@@ -65,8 +66,7 @@ def _cmd_integrate(args) -> int:
     exact = np.array([np.max(np.abs(expm(A_tilde * t) @ g[0])) for t in times])
     # the scheme's own linear recursion g_{k+1} = R(τÃ) g_k (DESIGN §5), R its stability
     # polynomial: what the residual does above the truncation floor
-    R = sum(c * np.linalg.matrix_power(args.tau * A_tilde, j)
-            for j, c in enumerate(scheme.stability_polynomial()))  # fmt: skip
+    R = step_matrix(A_tilde, scheme, args.tau)
     steps = np.rint(times / args.tau).astype(int)
     discrete = np.array([np.max(np.abs(np.linalg.matrix_power(R, s) @ g[0])) for s in steps])
     print(f"integrated {ds.attrs['steps']} steps in {wall:.2f} s (compile included)")
@@ -110,7 +110,7 @@ def _cmd_theory(args) -> int:
         print(f"Theorem 4: L from ÃᵀL + LÃ = −I; Sylvester on L and on the symmetric part of "
               f"−LÃ: {'holds' if ly['holds'] else 'fails'}; proven rate {ly['beta']:.6g} s-1")
         scheme = study.setup()["scheme"]
-        lims = {c_: theory.tau_limit(A, scheme, c_) for c_ in theory.CONDITIONS}
+        lims = {c_: float(ds[f"tau_limit_{c_}"].values.flat[0]) for c_ in theory.CONDITIONS}
         print("Theorems 6/7, largest tau for " + scheme.name + ": " +
               ", ".join(f"{k} {v:.6g}" for k, v in lims.items()))  # fmt: skip
     print("\nper grid point (R = R(τÃ); cond: the weighted-norm condition of Theorems 6/7):")

@@ -32,24 +32,29 @@ _DIVERGED = int(Status.DIVERGED)
 DECAYED_FLOOR_FACTOR = 10.0
 
 
-def sampler_for(model: Model):
-    """The compiled perturbation sampler of ``model`` (memoized)."""
-    key = ("sampler",)
+def _memo(model: Model, key: tuple, build):
+    """``build()`` once per model and key (every new closure is a new compilation)."""
     cache = model._kernel_cache
     if key not in cache:
-        from ._laws import none
-
-        cache[key] = build_sampler(kernels_for(model, bind_law(none(), model)))
+        cache[key] = build()
     return cache[key]
+
+
+def _unstabilized(model: Model):
+    from ._laws import none
+
+    return kernels_for(model, bind_law(none(), model))
+
+
+def sampler_for(model: Model):
+    """The compiled perturbation sampler of ``model`` (memoized)."""
+    return _memo(model, ("sampler",), lambda: build_sampler(_unstabilized(model)))
 
 
 def ensemble_kernel_for(model: Model, bound, stages: int, block: int):
     """The block-lockstep ensemble kernel (memoized per law kind, stage count, block)."""
-    key = ("ensemble", bound.code, bound.fn, stages, block)
-    cache = model._kernel_cache
-    if key not in cache:
-        cache[key] = build_soa_kernel(kernels_for(model, bound), stages, block)
-    return cache[key]
+    return _memo(model, ("ensemble", bound.code, bound.fn, stages, block),
+                 lambda: build_soa_kernel(kernels_for(model, bound), stages, block))  # fmt: skip
 
 
 # --------------------------------------------------------------------- sampling
@@ -103,14 +108,9 @@ def _place(model, targets, p, t0, threads=None):
 
 def _residual_rows(model, x, p, t0, threads=None):
     """``g(x_i, t0)`` for every row of ``x`` (compiled; NaN rows give NaN)."""
-    key = ("residual_rows",)
-    cache = model._kernel_cache
-    if key not in cache:
-        from ._laws import none
-
-        cache[key] = build_residual_rows(kernels_for(model, bind_law(none(), model)))
+    kernel = _memo(model, ("residual_rows",),
+                   lambda: build_residual_rows(_unstabilized(model)))  # fmt: skip
     out = np.empty((x.shape[0], model.n_residual))
-    kernel = cache[key]
     run_chunks(lambda lo, hi: kernel(x, t0, p, out, lo, hi), -(-x.shape[0] // CHUNK),
                threads=threads)  # fmt: skip
     return out

@@ -225,22 +225,11 @@ def summary(ds: xr.Dataset) -> str:
              "beta_med", "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
              "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
              "beta_theorem5_printed": "b5_printed"}  # fmt: skip
-    dims = [d for d in ds["fraction_bounded"].dims]
-    flat = ds[cols].stack(point=dims) if dims else ds[cols].expand_dims(point=[0])
-    head = dims + [short[c] for c in cols]
-    rows = []
-    for i in range(flat.sizes["point"]):
-        row = [f"{float(flat[d].values[i]):.4g}" for d in dims]
-        for c in cols:
-            v = float(flat[c].values[i])
-            row.append(("yes" if v == 1 else "no") if c == "norm_condition" else f"{v:.4g}")
-        rows.append(row)
-    width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
-    lines = ["", "summary (bounded: fraction of members; delta*: stability radius; "
-             "beta_pred = -ln rho(R)/tau):"]  # fmt: skip
-    lines.append("  ".join(h.rjust(w) for h, w in zip(head, width)))
-    lines += ["  ".join(x.rjust(w) for x, w in zip(r, width)) for r in rows]
-    return "\n".join(lines)
+    from .theory import grid_table
+
+    head = ("summary (bounded: fraction of members; delta*: stability radius; "
+            "beta_pred = -ln rho(R)/tau):")  # fmt: skip
+    return "\n" + head + "\n" + grid_table(ds, cols, short, flags=("norm_condition",)) + "\n"
 
 
 class _Progress:

@@ -246,7 +246,7 @@ def load_study(path, *, members: int | None = None) -> Study:
         if canon in axes:
             fail(f"[sweep] {name}", f"sweeps {canon} twice")
         axes[canon] = values
-        _check_axis(canon, values, model, law, f"[sweep] {name}", fail)
+        _check_axis(canon, values, f"[sweep] {name}", fail)
 
     if "run.tau" in axes:
         span = run["t_end"] - model.t0
@@ -386,7 +386,7 @@ def snap_taus(taus, save_dt: float, span: float, fail=None) -> np.ndarray:
     return out
 
 
-def _check_axis(canon, values, model, law, key, fail):
+def _check_axis(canon, values, key, fail):
     positive = {"run.tau", "law.omega", "law.k"}
     if canon in positive and not np.all(values > 0):
         fail(key, f"values must be positive, got {values.tolist()}")

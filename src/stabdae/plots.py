@@ -19,9 +19,6 @@ import xarray as xr
 
 __all__ = ["plot_dataset", "stability_map", "decay_curves", "beta_comparison"]
 
-_GRID_VARS = ("fraction_bounded",)
-
-
 def _plt():
     import matplotlib
 

@@ -448,18 +448,26 @@ def for_study(study, *, path_steps: int = 2000) -> xr.Dataset:
         cols[name][idx] = value
 
     neighbourhood = None
+    per_law: dict = {}
     for idx, values in study.points():
         s = study.setup(values)
         law, scheme, tau = s["law"], s["scheme"], s["tau"]
         p = model.param_vector(s["params"])
         if law.is_constant:
             A = law.A_tilde(model)
-            c = continuous(A)
-            ly = lyapunov(A)
-            d = discrete(A, scheme, tau)
-            put("beta_theory", idx, c["beta"])
-            put("lyapunov_holds", idx, float(ly["holds"]))
-            put("beta_lyapunov", idx, ly["beta"])
+            # what depends on Ã (and the scheme) alone is computed once per distinct law,
+            # not at every τ of the grid: the τ limits are four bisections each
+            key = (A.tobytes(), A.shape, scheme.name, tuple(sorted(scheme.params.items())))
+            if key not in per_law:
+                c, ly = continuous(A), lyapunov(A)
+                per_law[key] = {
+                    "beta_theory": c["beta"], "lyapunov_holds": float(ly["holds"]),
+                    "beta_lyapunov": ly["beta"],
+                    **{f"tau_limit_{k}": tau_limit(A, scheme, k) for k in CONDITIONS},
+                }  # fmt: skip
+            for k, v in per_law[key].items():
+                put(k, idx, v)
+            d = discrete(A, scheme, tau, limits=False)
             rho = d.spectral_radius
             put("beta_theory_discrete", idx, -math.log(rho) / tau if rho > 0 else math.inf)
             for k, v in d.as_dict().items():
@@ -514,7 +522,6 @@ _UNITS = {"beta_theory": "s-1", "beta_lyapunov": "s-1", "beta_theory_discrete": 
 
 def format_table(ds: xr.Dataset, columns=None) -> str:
     """A readable table of :func:`for_study`'s dataset, one row per grid point."""
-    dims = list(ds.dims)
     columns = columns or [v for v in ("spectral_radius", "norm_max", "norm_weighted",
                                       "norm_condition", "beta_theory", "beta_theory_discrete",
                                       "lyapunov_holds", "tau_limit_spectral",
@@ -528,19 +535,26 @@ def format_table(ds: xr.Dataset, columns=None) -> str:
              "theorem5_lambda_min_W": "lmin(W)", "theorem5_beta_proven": "b_proven",
              "theorem5_beta_printed": "b_printed", "path_spectral_radius_max": "rho_path",
              "path_norm_weighted_max": "q_path", "path_epsilon": "eps_path"}  # fmt: skip
+    return grid_table(ds, columns, short, flags=("norm_condition", "lyapunov_holds"),
+                      precise=("norm_weighted", "spectral_radius", "path_norm_weighted_max"))
+
+
+def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) -> str:
+    """One row per grid point of ``ds`` (its swept dimensions first, then ``columns``,
+    headed by ``short`` names): ``flags`` as yes/no, ``precise`` with 6 digits (the ones
+    that decide "< 1"), the rest with 4."""
+    dims = list(ds[columns[0]].dims)
+    flat = ds[columns].stack(point=dims) if dims else ds[columns].expand_dims(point=[0])
     head = [d.split(".", 1)[-1] for d in dims] + [short.get(c, c) for c in columns]
     rows = []
-    flat = ds.stack(point=dims) if dims else ds.expand_dims(point=[0])
     for i in range(flat.sizes["point"]):
         row = [f"{float(flat[d].values[i]):.4g}" for d in dims]
         for c in columns:
             v = float(flat[c].values[i])
-            if c in ("norm_condition", "lyapunov_holds"):
+            if c in flags:
                 row.append("yes" if v == 1 else "no")
-            elif c in ("norm_weighted", "spectral_radius", "path_norm_weighted_max"):
-                row.append(f"{v:.6g}")  # the digits that decide "< 1"
             else:
-                row.append(f"{v:.4g}")
+                row.append(f"{v:.6g}" if c in precise else f"{v:.4g}")
         rows.append(row)
     width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
     lines = ["  ".join(h.rjust(w) for h, w in zip(head, width))]
