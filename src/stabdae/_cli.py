@@ -1,4 +1,4 @@
-"""Command line: ``stabdae check``, ``integrate``, ``theory`` (and ``run``, ``plot``)."""
+"""Command line: ``stabdae check``, ``integrate``, ``theory``, ``run``, ``plot``, ``generate``."""
 
 from __future__ import annotations
 
@@ -145,6 +145,30 @@ def _cmd_plot(args) -> int:
     return 0
 
 
+def _cmd_generate(args) -> int:
+    try:
+        from .symbolic import load_spec
+    except ImportError as exc:
+        print(f"stabdae generate: error: {exc}", file=sys.stderr)
+        return 2
+    start = time.perf_counter()
+    system = load_spec(args.spec)
+    if args.output is None:
+        print(system.source(args.spec), end="")
+        return 0
+    out = system.write(args.output, spec=args.spec)
+    print(f"model {system.name!r} (n = {system.n}, m = {system.m}, k = {system.k}) written to "
+          f"{out} in {time.perf_counter() - start:.1f} s")  # fmt: skip
+    if args.no_check:
+        return 0
+    from ._loading import load_model
+
+    model = load_model(out)
+    report = model.check()
+    print(report)
+    return 0 if report.ok else 1
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="stabdae",
@@ -203,6 +227,14 @@ def main(argv: list[str] | None = None) -> int:
     plt_.add_argument("dataset", help="NetCDF written by stabdae run")
     plt_.add_argument("-o", "--output", help="folder or file stem for the pictures")
     plt_.set_defaults(func=_cmd_plot)
+
+    gen = sub.add_parser("generate", help="derive a model file from a symbolic Lagrangian "
+                         "(sympy spec file)")  # fmt: skip
+    gen.add_argument("spec", help="spec file (.py) defining system = stabdae.symbolic.System")
+    gen.add_argument("-o", "--output", help="model file to write (default: print it)")
+    gen.add_argument("--no-check", action="store_true",
+                     help="do not load and check the written model")  # fmt: skip
+    gen.set_defaults(func=_cmd_generate)
 
     args = parser.parse_args(argv)
     try:

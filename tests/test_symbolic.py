@@ -1,0 +1,235 @@
+"""stabdae.symbolic: models generated from a sympy Lagrangian.
+
+References: the hand-written scenes (every function, at random states, to 1e-12), the exact
+residual law g(t) = expm(Ã t) g(0) (DESIGN §3) for a system with no hand-written scene,
+and the conical spherical pendulum's closed-form motion.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+from test_residual_law import constant_laws, relative_law_error
+
+import stabdae
+from conftest import KERNELS, load_scene
+from stabdae._cli import main
+from stabdae.symbolic import SymbolicError, System, coordinates, generate, load_spec
+
+SPECS = KERNELS / "specs"
+PIECES = ["mass", "forces", "f", "f_q", "f_t", "f_accel", "h", "h_q", "h_v", "h_t"]
+
+
+def generated(tmp_path: Path, spec: Path) -> stabdae.Model:
+    out = generate(spec, tmp_path / f"{spec.stem}_gen.py")
+    return stabdae.load_model(out)
+
+
+def piece_value(model: stabdae.Model, piece: str, t: float, x, p):
+    """A piece's value; an absent mass is the identity, absent f_t/h_t zero."""
+    if piece in model.functions:
+        return np.asarray(model.evaluate(piece, t, x, p))
+    if piece == "mass":
+        return np.eye(model.n)
+    if piece == "f_t" and model.m:
+        return np.zeros(model.m)
+    if piece == "h_t" and model.k:
+        return np.zeros(model.k)
+    return None
+
+
+def largest_difference(a: stabdae.Model, b: stabdae.Model, states: int = 6, seed: int = 0):
+    """max over pieces and random states of |a − b| / max(1, |b|), and the pieces compared."""
+    assert a.param_names == b.param_names
+    rng = np.random.default_rng(seed)
+    p = b.default_params()
+    worst, compared = 0.0, set()
+    for _ in range(states):
+        x = b.reference_state(p) + rng.standard_normal(2 * b.n)
+        t = float(rng.uniform(0.0, 3.0))
+        for piece in PIECES:
+            va, vb = piece_value(a, piece, t, x, p), piece_value(b, piece, t, x, p)
+            if vb is None:
+                assert va is None, f"{piece} generated but absent from the hand-written scene"
+                continue
+            assert va.shape == vb.shape, piece
+            worst = max(worst, float(np.max(np.abs(va - vb) / np.maximum(1.0, np.abs(vb)))))
+            compared.add(piece)
+        if b.energy is not None:
+            ea, eb = a.energy(t, x[: a.n], x[a.n :], p), b.energy(t, x[: b.n], x[b.n :], p)
+            worst = max(worst, abs(ea - eb) / max(1.0, abs(eb)))
+            compared.add("energy")
+    return worst, compared
+
+
+@pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "chaplygin_sleigh"])
+def test_generated_equals_hand_written(tmp_path, name):
+    model = generated(tmp_path, SPECS / f"{name}.py")
+    hand = load_scene(name)
+    worst, compared = largest_difference(model, hand)
+    assert worst <= 1e-12, (name, worst)
+    assert {"forces", "energy"} <= compared
+    assert model.check().ok
+    np.testing.assert_allclose(model.reference_state(), hand.reference_state(), atol=1e-15)
+
+
+def test_comparison_can_fail(tmp_path):
+    """A generated model that differs in one parameter's role is caught by the comparison."""
+    (x, y), (xd, yd) = coordinates("x y")
+    g, l = sp.symbols("g l")
+    wrong = System(
+        "pendulum_wrong", q=[x, y], v=[xd, yd],
+        lagrangian=(xd**2 + yd**2) / 2 - 1.01 * g * y,  # gravity 1 % too strong
+        holonomic=[x**2 + y**2 - l**2], params={g: 9.81, l: 1.0},
+        reference_state=list(load_scene("pendulum").reference_state()),
+    )  # fmt: skip
+    model = stabdae.load_model(wrong.write(tmp_path / "wrong.py"))
+    worst, _ = largest_difference(model, load_scene("pendulum"))
+    assert worst > 1e-3
+
+
+def test_time_dependent_constraint(tmp_path):
+    """f_t and the time terms of f_accel: the varying-length pendulum, l(t) = l0(1 + ε sin Ωt)."""
+    hand = load_scene("pendulum_varying_length")
+    (x, y), (xd, yd) = coordinates("x y")
+    g, l0, eps, om = sp.symbols("g l0 eps Omega")
+    t = stabdae.symbolic.t
+    length = l0 * (1 + eps * sp.sin(om * t))
+    system = System(
+        "varying_generated", q=[x, y], v=[xd, yd],
+        lagrangian=(xd**2 + yd**2) / 2 - g * y,
+        holonomic=[x**2 + y**2 - length**2],
+        params={g: 9.81, l0: 1.0, eps: 0.1, om: 3.0},
+        reference_state=[float(c) for c in hand.reference_state()], energy=False,
+    )  # fmt: skip
+    assert "f_t" in system.derive()
+    model = stabdae.load_model(system.write(tmp_path / "varying.py"))
+    worst, compared = largest_difference(model, hand)
+    assert "f_t" in compared
+    assert worst <= 1e-12
+    assert model.check().ok
+
+
+def test_spherical_pendulum_exact_residual_law(tmp_path):
+    """No hand-written scene: generated, then the foundation issue's residual-law test."""
+    model = generated(tmp_path, SPECS / "spherical_pendulum.py")
+    assert (model.n, model.m, model.k) == (3, 1, 0)
+    assert model.check().ok
+    rng = np.random.default_rng(7)
+    x0 = model.reference_state() + 1e-3 * rng.standard_normal(6)
+    assert np.max(np.abs(model.residual(x0))) > 1e-5
+    for law_name, law in constant_laws(model).items():
+        err = relative_law_error(model, law, x0)
+        assert err <= 1e-6, (law_name, err)
+
+
+def test_spherical_pendulum_conical_motion(tmp_path):
+    """Closed form: from the reference state the mass circles at Ω = √(g/(l cos θ0)) at
+    constant height; RK4 at τ = 1e-3 over 2 s reproduces it to 1e-9."""
+    model = generated(tmp_path, SPECS / "spherical_pendulum.py")
+    p = model.default_params()
+    g, l = p[1], p[2]
+    theta0 = 0.5
+    rate = math.sqrt(g / (l * math.cos(theta0)))
+    ds = stabdae.integrate(model, model.reference_state(), stabdae.baumgarte(10.0, 1.0),
+                           "rk4", 1e-3, 2.0, 0.1)  # fmt: skip
+    t = ds.time.values
+    q = ds["x"].values[:, :3]
+    exact = np.stack([l * math.sin(theta0) * np.cos(rate * t),
+                      l * math.sin(theta0) * np.sin(rate * t),
+                      np.full_like(t, -l * math.cos(theta0))], axis=1)  # fmt: skip
+    assert np.max(np.abs(q - exact)) < 1e-9
+
+
+def test_committed_scene_is_fresh(tmp_path):
+    """kernels/spherical_pendulum.py was generated from the spec as it is now."""
+    spec = SPECS / "spherical_pendulum.py"
+    text = (KERNELS / "spherical_pendulum.py").read_text()
+    recorded = re.search(r"Spec SHA-256: ([0-9a-f]{16})", text).group(1)
+    assert recorded == hashlib.sha256(spec.read_bytes()).hexdigest()[:16], (
+        "regenerate: stabdae generate kernels/specs/spherical_pendulum.py "
+        "-o kernels/spherical_pendulum.py"
+    )
+    worst, _ = largest_difference(load_scene("spherical_pendulum"), generated(tmp_path, spec))
+    assert worst == 0.0
+
+
+@pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "chaplygin_sleigh",
+                                  "spherical_pendulum"])  # fmt: skip
+def test_generated_file_is_readable(name):
+    """A header saying how it was made, lines within 100 characters, no leftover symbols."""
+    system = load_spec(SPECS / f"{name}.py")
+    text = system.source(SPECS / f"{name}.py")
+    compile(text, name, "exec")
+    assert "Generated by `stabdae generate" in text and "Spec SHA-256" in text
+    assert max(len(line) for line in text.splitlines()) <= 100
+    assert "**2" not in text.split('"""', 2)[2]  # squares written as products
+    assert text.count("@njit") == len(system.derive())
+
+
+def spec_system(**overrides):
+    (x, y), (xd, yd) = coordinates("x y")
+    g, l = sp.symbols("g l")
+    kw = dict(
+        q=[x, y], v=[xd, yd], lagrangian=(xd**2 + yd**2) / 2 - g * y,
+        holonomic=[x**2 + y**2 - l**2], params={g: 9.81, l: 1.0},
+        reference_state=[0, -1, 1, 0],
+    )  # fmt: skip
+    kw.update(overrides)
+    return System("bad", **kw)
+
+
+def test_errors_name_the_piece_and_symbol():
+    (x, y), (xd, yd) = coordinates("x y")
+    k = sp.Symbol("k")
+    with pytest.raises(SymbolicError, match=r"lagrangian uses 'k'"):
+        spec_system(lagrangian=(xd**2 + yd**2) / 2 - k * y)
+    with pytest.raises(SymbolicError, match=r"holonomic\[0\].*must not contain velocities.*"
+                                            r"'x_dot'"):  # fmt: skip
+        spec_system(holonomic=[x * xd])
+    with pytest.raises(SymbolicError, match=r"reference_state must have 2n = 4 entries.* got 3"):
+        spec_system(reference_state=[0, -1, 1])
+    with pytest.raises(SymbolicError, match=r"reference_state\[1\] \(parameters only\) uses 'y'"):
+        spec_system(reference_state=[0, y, 1, 0])
+    with pytest.raises(SymbolicError, match=r"mass matrix .* depends on the velocities"):
+        spec_system(lagrangian=(xd**2 + yd**2) / 2 + xd**4).derive()
+    with pytest.raises(SymbolicError, match="no constraints"):
+        spec_system(holonomic=[])
+    with pytest.raises(SymbolicError, match="forces must have n = 2 entries, got 1"):
+        spec_system(forces=[xd])
+
+
+def test_nonconservative_forces_enter_gamma():
+    """M v̇ = Fᵀλ − γ with γ = … − Q: a damping force −c v appears as +c v in γ."""
+    (x, y), (xd, yd) = coordinates("x y")
+    c = sp.Symbol("c")
+    system = spec_system(forces=[-c * xd, -c * yd], params={sp.Symbol("g"): 9.81,
+                                                            sp.Symbol("l"): 1.0, c: 0.3})
+    gamma = system.derive()["forces"]
+    assert sp.simplify(gamma[0] - c * xd) == 0
+    assert sp.simplify(gamma[1] - (sp.Symbol("g") + c * yd)) == 0
+
+
+def test_cli_generate(tmp_path, capsys):
+    out = tmp_path / "sph.py"
+    code = main(["generate", str(SPECS / "spherical_pendulum.py"), "-o", str(out)])
+    text = capsys.readouterr().out
+    assert code == 0 and out.is_file()
+    assert "written to" in text and "all pieces agree" in text
+    assert main(["generate", str(SPECS / "pendulum.py")]) == 0
+    assert "def f_accel(t, q, v, p, out):" in capsys.readouterr().out
+
+
+def test_cli_generate_bad_spec(tmp_path, capsys):
+    spec = tmp_path / "empty.py"
+    spec.write_text("x = 1\n")
+    assert main(["generate", str(spec), "-o", str(tmp_path / "m.py")]) == 2
+    err = capsys.readouterr().err
+    assert "must define one stabdae.symbolic.System" in err
+    assert not (tmp_path / "m.py").exists()
