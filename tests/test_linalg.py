@@ -43,3 +43,18 @@ def test_singular_indefinite_and_nan_are_reported():
     near = np.array([[1.0, 1.0], [1.0, 1.0 + 1e-14]])
     assert ldl_inplace(near.copy(), 2, 1e-12) == 2
     assert ldl_inplace(near.copy(), 2, 1e-16) == 0
+
+
+@pytest.mark.parametrize("n,rank", [(1, 1), (3, 3), (4, 3), (5, 2), (6, 6)])
+def test_pinv_solve_sym_matches_numpy_pinv(n, rank):
+    """The least-squares multiplier: S⁺b against numpy.linalg.pinv, full and deficient rank."""
+    from stabdae._linalg import pinv_solve_sym
+
+    rng = np.random.default_rng(n + rank)
+    F = rng.standard_normal((n, rank)) @ rng.standard_normal((rank, n))
+    S, b = F @ F.T, rng.standard_normal(n)
+    want = np.linalg.pinv(S, rcond=1e-10) @ b
+    a, got = np.tril(S).copy(), b.copy()
+    r = pinv_solve_sym(a, n, got, 1e-10, np.empty((n, n)), np.empty(n), np.empty(n))
+    assert r == rank
+    assert np.max(np.abs(got - want)) <= 1e-12 * np.max(np.abs(want))

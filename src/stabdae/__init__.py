@@ -5,12 +5,13 @@ The public API is exactly what this module re-exports.
 """
 
 from . import theory  # noqa: E402  (submodule: stabdae.theory)
+from ._adaptive import integrate_adaptive
 from ._ensemble import ensemble, sample_perturbations
 from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, baumgarte, matrix, none, theorem5, user
 from ._loading import load_model, scene_names
 from ._model import Model, ModelError
-from ._schemes import Scheme, SchemeError, euler, heun, midpoint, rk4, two_stage
+from ._schemes import Scheme, SchemeError, dopri5, euler, heun, midpoint, rk4, two_stage
 from ._status import Status
 from ._version import __version__
 
@@ -25,10 +26,12 @@ __all__ = [
     "Status",
     "__version__",
     "baumgarte",
+    "dopri5",
     "ensemble",
     "euler",
     "heun",
     "integrate",
+    "integrate_adaptive",
     "load_model",
     "matrix",
     "midpoint",

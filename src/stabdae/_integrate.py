@@ -14,7 +14,7 @@ from ._cache import kernel_key, keyed_cache
 from ._dataset import model_coords, provenance, variable
 from ._laws import as_law, bind_law
 from ._model import Model
-from ._rhs import kernels_for
+from ._rhs import MULTIPLIERS, kernels_for
 from ._schemes import as_scheme
 from ._status import Status, status_flag_attrs
 
@@ -30,19 +30,25 @@ class IntegrationWarning(RuntimeWarning):
 Stepper = namedtuple("Stepper", "step integrate")
 
 
-def stepper_for(model: Model, bound) -> Stepper:
+def stepper_for(model: Model, bound, multiplier: str = "ldl") -> Stepper:
     """The compiled RK step and single-trajectory loop for ``model`` under the law's kind
     (memoized on the model)."""
-    key = ("stepper", bound.code, bound.fn)
+    key = ("stepper", bound.code, bound.fn, multiplier)
     cache = model._kernel_cache
     if key not in cache:
-        cache[key] = _build_stepper(kernels_for(model, bound))
+        cache[key] = _build_stepper(kernels_for(model, bound, multiplier))
     return cache[key]
 
 
-def integrator_for(model: Model, bound):
+def integrator_for(model: Model, bound, multiplier: str = "ldl"):
     """The compiled single-trajectory loop for ``model`` under the law's kind."""
-    return stepper_for(model, bound).integrate
+    return stepper_for(model, bound, multiplier).integrate
+
+
+def check_multiplier(multiplier, who: str) -> str:
+    if multiplier not in MULTIPLIERS:
+        raise ValueError(f"{who}: multiplier must be one of {MULTIPLIERS}, got {multiplier!r}")
+    return multiplier
 
 
 def _build_stepper(K):
@@ -147,6 +153,7 @@ def integrate(
     *,
     params=None,
     t0: float | None = None,
+    multiplier: str = "ldl",
 ) -> xr.Dataset:
     """Integrate one trajectory of the stabilized equations (3.1), (3.11).
 
@@ -172,6 +179,10 @@ def integrate(
         Physical parameters overriding the model's defaults.
     t0 : float, optional
         Initial time (default ``model.t0``).
+    multiplier : {"ldl", "lstsq"}
+        How λ is solved from (3.11): ``"ldl"`` factorizes ``S`` and stops with status
+        ``SINGULAR_S`` when it is singular (redundant constraints); ``"lstsq"`` takes the
+        minimum-norm least-squares λ (pseudo-inverse of ``S``) and keeps integrating.
 
     Returns
     -------
@@ -218,8 +229,9 @@ def integrate(
     if not np.all(np.isfinite(x0)):
         raise ValueError("integrate: x0 has non-finite entries")
 
+    multiplier = check_multiplier(multiplier, "integrate")
     bound = bind_law(law, model)
-    kernel = integrator_for(model, bound)
+    kernel = integrator_for(model, bound, multiplier)
     nsave = nsteps // save_every + 1
     out_x = np.full((nsave, 2 * model.n), np.nan)
     out_g = np.full((nsave, model.n_residual), np.nan)
@@ -239,7 +251,8 @@ def integrate(
     times = t0 + tau * save_every * np.arange(nsave)
     return _trajectory_dataset(
         model, p, law, scheme, times, out_x, out_g, out_e, status, done,
-        dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=save_dt, steps=nsteps),
+        dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=save_dt, steps=nsteps,
+             multiplier=multiplier),
     )  # fmt: skip
 
 

@@ -108,3 +108,78 @@ def ldl_solve_columns(l, n, b, ncols):
             for p in range(i + 1, n):
                 s -= l[p, i] * b[p, c]
             b[i, c] = s
+
+
+@njit(cache=True, error_model="numpy")
+def pinv_solve_sym(a, n, b, rtol, V, w, tmp):
+    """``b[:n] ← S⁺ b`` for the symmetric ``S`` whose lower triangle is in ``a[:n, :n]``.
+
+    The least-squares multiplier of a redundant constraint set: ``S = F M⁻¹ Fᵀ`` is then
+    singular, and the minimum-norm solution of ``min ‖S λ − b‖`` gives the same
+    acceleration ``Y λ`` as any exact solution when one exists.  Cyclic Jacobi rotations
+    diagonalize ``S = V diag(w) Vᵀ`` (``a`` is overwritten); eigenvalues with
+    ``|w_i| ≤ rtol · max |w|`` are treated as zero.  ``V`` (n×n), ``w`` and ``tmp`` (n)
+    are scratch.  Returns the numerical rank (0 for a zero or non-finite matrix).
+    """
+    for i in range(n):
+        for j in range(i):
+            a[j, i] = a[i, j]
+        for j in range(n):
+            V[i, j] = 1.0 if i == j else 0.0
+    for _sweep in range(64):
+        off = 0.0
+        diag = 0.0
+        for i in range(n):
+            diag += a[i, i] * a[i, i]
+            for j in range(i):
+                off += a[i, j] * a[i, j]
+        if not (off > 1e-32 * diag):  # converged (or NaN: handled below)
+            break
+        for p in range(n):
+            for q in range(p + 1, n):
+                apq = a[p, q]
+                if apq == 0.0:
+                    continue
+                # rotation in the (p, q) plane that zeroes a[p, q]
+                theta = (a[q, q] - a[p, p]) / (2.0 * apq)
+                t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                s = t * c
+                for k in range(n):  # A ← A J
+                    akp, akq = a[k, p], a[k, q]
+                    a[k, p] = c * akp - s * akq
+                    a[k, q] = s * akp + c * akq
+                for k in range(n):  # A ← Jᵀ A
+                    apk, aqk = a[p, k], a[q, k]
+                    a[p, k] = c * apk - s * aqk
+                    a[q, k] = s * apk + c * aqk
+                for k in range(n):  # V ← V J
+                    vkp, vkq = V[k, p], V[k, q]
+                    V[k, p] = c * vkp - s * vkq
+                    V[k, q] = s * vkp + c * vkq
+    wmax = 0.0
+    for i in range(n):
+        w[i] = a[i, i]
+        wmax = max(wmax, abs(w[i]))
+    if not (wmax > 0.0 and math.isfinite(wmax)):
+        for i in range(n):
+            b[i] = 0.0 if wmax == 0.0 else math.nan
+        return 0
+    rank = 0
+    for i in range(n):  # tmp = diag(w)⁺ Vᵀ b
+        s = 0.0
+        for k in range(n):
+            s += V[k, i] * b[k]
+        if abs(w[i]) > rtol * wmax:
+            tmp[i] = s / w[i]
+            rank += 1
+        else:
+            tmp[i] = 0.0
+    for k in range(n):  # b = V tmp
+        s = 0.0
+        for i in range(n):
+            s += V[k, i] * tmp[i]
+        b[k] = s
+    return rank

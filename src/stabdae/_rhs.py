@@ -32,7 +32,7 @@ from numba import njit
 
 from ._cache import fingerprint, optional_fingerprint, tag
 from ._laws import LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw
-from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
+from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace, pinv_solve_sym
 from ._model import Model
 from ._status import Status
 
@@ -40,6 +40,12 @@ from ._status import Status
 # reports a singular matrix instead of producing huge or NaN multipliers.
 MASS_RTOL = 1e-14
 S_RTOL = 1e-12
+#: eigenvalues of S below this fraction of the largest are zero for the least-squares
+#: (pseudo-inverse) multiplier of redundant constraints
+S_PINV_RTOL = 1e-10
+#: the multiplier solves of (3.11): L D Lᵀ (a singular S stops with a status) or the
+#: pseudo-inverse (redundant constraints: least-squares λ, integration goes on)
+MULTIPLIERS = ("ldl", "lstsq")
 
 _OK = int(Status.OK)
 _SINGULAR_S = int(Status.SINGULAR_S)
@@ -80,20 +86,20 @@ def _rejit(fn, absent):
     return njit(error_model="numpy", inline="always")(fn.py_func)
 
 
-def kernels_for(model: Model, bound: BoundLaw) -> Kernels:
+def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kernels:
     """Compiled ``rhs``, ``residual`` and ``energy`` for ``model`` under the law's kind.
 
     Memoized on the model, since every new closure is a new compilation.  Numeric law data
     (``A``, ``L``, gains) are runtime arguments, so sweeping them reuses the same kernels.
     """
-    key = (bound.code, bound.fn)
+    key = (bound.code, bound.fn) if multiplier == "ldl" else (bound.code, bound.fn, multiplier)
     cache = model._kernel_cache
     if key not in cache:
-        cache[key] = _build(model, bound.code, bound.fn)
+        cache[key] = _build(model, bound.code, bound.fn, multiplier == "lstsq")
     return cache[key]
 
 
-def _build(model: Model, law_code: int, law_fn) -> Kernels:
+def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     # These closures are inlined into the kernels that Python calls (integrate, sample,
     # ensemble); those get an explicit on-disk cache key from :mod:`._cache`.
     # Compile-time constants of the closure.
@@ -104,6 +110,7 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
     HAS_FT = "f_t" in fns
     HAS_HT = "h_t" in fns
     LAW = law_code
+    LSTSQ = lstsq
     mass = _rejit(fns.get("mass"), _noop4)
     forces = _rejit(fns["forces"], None)
     f_fn = _rejit(fns.get("f"), _noop4)
@@ -140,6 +147,9 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
             np.empty((r, ng)),  # 13 A of a user law
             np.empty((kk, kk)),  # 14 W = h_v h_vᵀ (Theorem 5)
             np.empty(kk),  # 15 L h (Theorem 5)
+            np.empty((r, r)),  # 16 eigenvectors of S (least-squares multiplier)
+            np.empty(r),  # 17 eigenvalues of S
+            np.empty(r),  # 18 scratch of size r
         )
 
     @njit(inline="always")
@@ -256,8 +266,11 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
                     fij = fq[i, j] if i < m else hv[i - m, j]
                     s += fij * Y[j, c]
                 S[i, c] = s
-        bad_S = ldl_inplace(S, r, S_RTOL) != 0
-        ldl_solve_inplace(S, r, rl)  # rl is now λ
+        if LSTSQ:  # redundant constraints: the minimum-norm least-squares λ
+            bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws[16], ws[17], ws[18]) == 0
+        else:
+            bad_S = ldl_inplace(S, r, S_RTOL) != 0
+            ldl_solve_inplace(S, r, rl)  # rl is now λ
 
         for j in range(n):
             s = -z[j]
@@ -283,6 +296,7 @@ def _build(model: Model, law_code: int, law_fn) -> Kernels:
         "kernels", n, m, k,
         tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
         optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
+        *(("lstsq",) if lstsq else ()),
     )  # fmt: skip
     tag(key, rhs, residual, energy, make_workspace)
     return Kernels(rhs, residual, energy, make_workspace, n, m, k, ng, key)

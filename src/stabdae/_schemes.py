@@ -108,9 +108,11 @@ class Scheme:
         return f"Scheme({self.name!r}, order={self.order}{extra})"
 
 
-def _tableau_order(A, b, c, max_order: int = 4) -> int:
-    """Highest order ≤ 4 whose Butcher order conditions hold to 1e-12."""
+def _tableau_order(A, b, c, max_order: int = 5) -> int:
+    """Highest order ≤ 5 whose Butcher order conditions hold to 1e-12 (one per rooted
+    tree: 1, 1, 2, 4, 9 conditions for orders 1 … 5)."""
     e = np.ones_like(b)
+    Ac = A @ c
     conds = {
         1: [b @ e - 1.0],
         2: [b @ c - 1 / 2],
@@ -120,6 +122,17 @@ def _tableau_order(A, b, c, max_order: int = 4) -> int:
             b @ (c * (A @ c)) - 1 / 8,
             b @ (A @ c**2) - 1 / 12,
             b @ (A @ (A @ c)) - 1 / 24,
+        ],
+        5: [
+            b @ c**4 - 1 / 5,
+            b @ (c**2 * Ac) - 1 / 10,
+            b @ (c * (A @ c**2)) - 1 / 15,
+            b @ (c * (A @ Ac)) - 1 / 30,
+            b @ (Ac * Ac) - 1 / 20,
+            b @ (A @ c**3) - 1 / 20,
+            b @ (A @ (c * Ac)) - 1 / 40,
+            b @ (A @ (A @ c**2)) - 1 / 60,
+            b @ (A @ (A @ Ac)) - 1 / 120,
         ],
     }
     order = 0
@@ -190,7 +203,39 @@ def rk4() -> Scheme:
     return Scheme("rk4", A, [1 / 6, 1 / 3, 1 / 3, 1 / 6], [0, 0.5, 0.5, 1], 4, {})
 
 
-_BY_NAME = {"euler": euler, "midpoint": midpoint, "rk2": midpoint, "heun": heun, "rk4": rk4}
+#: Dormand–Prince 5(4): nodes, coefficients, the fifth-order weights and the embedded
+#: fourth-order weights (Hairer, Nørsett & Wanner, Solving ODEs I, Table II.5.2)
+_DP_C = [0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0]
+_DP_A = [
+    [0, 0, 0, 0, 0, 0, 0],
+    [1 / 5, 0, 0, 0, 0, 0, 0],
+    [3 / 40, 9 / 40, 0, 0, 0, 0, 0],
+    [44 / 45, -56 / 15, 32 / 9, 0, 0, 0, 0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0, 0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0, 0],
+    [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
+]
+_DP_B = [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0]
+_DP_B_HAT = [5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 187 / 2100, 1 / 40]
+
+
+def dopri5() -> Scheme:
+    """Dormand–Prince 5(4), order 5 (the first-same-as-last 7-stage tableau).
+
+    As a fixed-step scheme it is an ordinary fifth-order method; with
+    :func:`stabdae.integrate_adaptive` its embedded fourth-order weights
+    (:func:`dopri5_embedded_weights`) estimate the local error for step-size control.
+    """
+    return Scheme("dopri5", _DP_A, _DP_B, _DP_C, 5, {})
+
+
+def dopri5_embedded_weights() -> np.ndarray:
+    """The embedded fourth-order weights b̂ of :func:`dopri5` (order checked on import)."""
+    return np.array(_DP_B_HAT)
+
+
+_BY_NAME = {"euler": euler, "midpoint": midpoint, "rk2": midpoint, "heun": heun, "rk4": rk4,
+            "dopri5": dopri5}  # fmt: skip
 
 
 def as_scheme(scheme, **params) -> Scheme:
@@ -213,3 +258,7 @@ def as_scheme(scheme, **params) -> Scheme:
             f"(stabdae.{scheme.__name__}(...)) or pass the name {scheme.__name__!r}"
         )
     raise SchemeError(f"scheme must be a Scheme or a name, got {type(scheme).__name__}")
+
+
+# the embedded weights must be a fourth-order (and not fifth-order) companion of b
+assert _tableau_order(np.array(_DP_A), np.array(_DP_B_HAT), np.array(_DP_C)) == 4

@@ -99,7 +99,8 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
         return (
             stack1(n), stack1(n), stack2(n, n), stack1(n), stack2(mk, n), stack2(kk, n),
             stack2(kk, n), stack2(n, r), stack2(r, r), stack1(r), stack1(ng), stack1(mk),
-            stack1(kk), stack2(r, ng), stack2(kk, kk), stack1(kk),
+            stack1(kk), stack2(r, ng), stack2(kk, kk), stack1(kk), stack2(r, r), stack1(r),
+            stack1(r),
         )  # fmt: skip
 
     @njit(error_model="numpy")

@@ -26,6 +26,10 @@ class Status(IntEnum):
     DIVERGED = 4
     #: the initial state could not be placed at the requested perturbation
     SAMPLING_FAILED = 5
+    #: adaptive integration: the step size fell below roundoff of the time
+    STEP_TOO_SMALL = 6
+    #: adaptive integration: the step budget (max_steps) was used up
+    MAX_STEPS = 7
 
     @property
     def description(self) -> str:
@@ -40,6 +44,9 @@ _DESCRIPTIONS = {
     Status.NONFINITE_STATE: "state became non-finite (NaN or inf)",
     Status.DIVERGED: "residual norm exceeded the divergence threshold",
     Status.SAMPLING_FAILED: "initial perturbation could not be reached by Gauss-Newton",
+    Status.STEP_TOO_SMALL: "adaptive step size fell below roundoff of the time (stiff, "
+    "singular or non-finite right-hand side)",
+    Status.MAX_STEPS: "adaptive integration used up max_steps",
 }
 
 

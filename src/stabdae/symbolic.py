@@ -305,7 +305,9 @@ class System:
         code.append(self._reference_function(names))
         imports = _IMPORTS if any("math." in c for c in code) else _IMPORTS.replace(
             "import math\n\n", "")
-        params = "# p = [" + ", ".join(str(s) for s in self.params) + "]"
+        params = "\n".join(textwrap.wrap("p = [" + ", ".join(str(s) for s in self.params) + "]",
+                                         _WIDTH - 2, initial_indent="# ",
+                                         subsequent_indent="#     "))  # fmt: skip
         blocks = [self._header(spec), imports + "\n\n" + params, *code,
                   self._model_call(pieces)]  # fmt: skip
         return "\n\n\n".join(blocks).rstrip() + "\n"
@@ -360,8 +362,11 @@ class System:
             args.append(f"m={self.m}")
         if self.k:
             args.append(f"k={self.k}")
-        params = ", ".join(f"{_quote(str(s))}: {val!r}" for s, val in self.params.items())
-        args.append("params={" + params + "}")
+        entries = [f"{_quote(str(s))}: {val!r}" for s, val in self.params.items()]
+        params = "params={" + ", ".join(entries) + "}"
+        if len(params) + 5 > _WIDTH:
+            params = "params={\n" + "".join(f"        {e},\n" for e in entries) + "    }"
+        args.append(params)
         args.append("reference_state=reference_state")
         args.append("coordinates=[" + ", ".join(_quote(str(s)) for s in self.q) + "]")
         if self.coordinate_units:
@@ -531,25 +536,63 @@ def _function(piece: str, expr, names: _LocalNames) -> str:
 
 
 def _assign(target: str, code: str, op: str = " =") -> str:
-    """``target = code`` within the line width, broken at top-level + and − if needed."""
+    """``target = code`` within the line width, broken inside parentheses if needed."""
     head = f"{target}{op} "
     if len(head) + len(code) + 4 <= _WIDTH:
         return head + code
-    terms = _split_top(code)
-    lines, cur = [], ""
-    for term in terms:
-        if cur and len(cur) + len(term) + 12 > _WIDTH:
-            lines.append(cur)
-            cur = term.lstrip()
-        else:
-            cur += term
-    lines.append(cur)
-    inner = "\n".join("    " + ln.strip() for ln in lines)
+    inner = "\n".join("    " + ln for ln in _break(code, 8))
     return f"{head}(\n{inner}\n)"
 
 
-def _split_top(code: str) -> list[str]:
-    """Split at the `` + `` / `` - `` that sit outside every parenthesis."""
+def _break(code: str, indent: int) -> list[str]:
+    """Lines of ``code`` (inside parentheses, so newlines are free) that fit the width:
+    split at top-level ``+``/``−``, then ``*``/``/``, then inside a call's parentheses."""
+    room = _WIDTH - indent
+    if len(code) <= room:
+        return [code]
+    for ops in ((" + ", " - "), (" * ", " / ")):
+        parts = _split_top(code, ops)
+        if len(parts) > 1:
+            lines, cur = [], ""
+            for part in parts:
+                if cur and len(cur) + len(part) > room:
+                    lines.append(cur)
+                    cur = part.lstrip()
+                else:
+                    cur += part
+                if len(cur) > room:  # one long operand: break it on its own lines
+                    op = ""
+                    for o in ops:
+                        if cur.startswith(o.strip() + " "):
+                            op, cur = o.strip() + " ", cur[len(o.strip()) + 1 :]
+                    sub = _break(cur, indent + len(op))
+                    lines.append(op + sub[0])
+                    lines.extend(" " * len(op) + ln for ln in sub[1:])
+                    cur = ""
+            if cur:
+                lines.append(cur)
+            return lines
+    opening = code.find("(")
+    if opening >= 0 and code.endswith(")") and _closing(code, opening) == len(code) - 1:
+        inner = _break(code[opening + 1 : -1], indent + 4)
+        return [code[: opening + 1], *("    " + ln for ln in inner), ")"]
+    return [code]
+
+
+def _closing(code: str, opening: int) -> int:
+    depth = 0
+    for i in range(opening, len(code)):
+        if code[i] == "(":
+            depth += 1
+        elif code[i] == ")":
+            depth -= 1
+            if depth == 0:
+                return i
+    return -1
+
+
+def _split_top(code: str, ops=(" + ", " - ")) -> list[str]:
+    """Split before the operators in ``ops`` that sit outside every parenthesis."""
     parts, depth, start, i = [], 0, 0, 0
     while i < len(code):
         ch = code[i]
@@ -557,7 +600,7 @@ def _split_top(code: str) -> list[str]:
             depth += 1
         elif ch in ")]":
             depth -= 1
-        elif depth == 0 and code.startswith((" + ", " - "), i) and i > start:
+        elif depth == 0 and code.startswith(ops, i) and i > start:
             parts.append(code[start:i])
             start = i
             i += 3
