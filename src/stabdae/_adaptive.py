@@ -16,7 +16,13 @@ import numpy as np
 from numba import njit
 
 from ._cache import kernel_key, keyed_cache, tag
-from ._integrate import IntegrationWarning, _positive, _trajectory_dataset, check_multiplier
+from ._integrate import (
+    IntegrationWarning,
+    _positive,
+    _trajectory_dataset,
+    check_multiplier,
+    initial_state,
+)
 from ._laws import as_law, bind_law
 from ._model import Model
 from ._rhs import kernels_for
@@ -272,16 +278,7 @@ def integrate_adaptive(
         save_times = np.minimum(t0 + save_dt * np.arange(1, count + 1), float(t_end))
         save_times[-1] = float(t_end)
     h0 = -1.0 if first_step is None else _positive(first_step, "first_step")
-    if x0 is None:
-        x0 = model.reference_state(p)
-    x0 = np.array(x0, dtype=np.float64)
-    if x0.shape != (2 * model.n,):
-        raise ValueError(
-            f"integrate_adaptive: x0 must have shape (2n,) = ({2 * model.n},) for model "
-            f"{model.name!r}, got {x0.shape}"
-        )
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("integrate_adaptive: x0 has non-finite entries")
+    x0 = initial_state(model, x0, p, "integrate_adaptive")
 
     scheme = dopri5()
     multiplier = check_multiplier(multiplier, "integrate_adaptive")

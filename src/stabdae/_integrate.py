@@ -45,6 +45,21 @@ def integrator_for(model: Model, bound, multiplier: str = "ldl"):
     return stepper_for(model, bound, multiplier).integrate
 
 
+def initial_state(model: Model, x0, p, who: str) -> np.ndarray:
+    """``x0`` as a finite float64 (2n,) array; the reference state when None."""
+    if x0 is None:
+        x0 = model.reference_state(p)
+    x0 = np.array(x0, dtype=np.float64)
+    if x0.shape != (2 * model.n,):
+        raise ValueError(
+            f"{who}: x0 must have shape (2n,) = ({2 * model.n},) for model {model.name!r}, "
+            f"got {x0.shape}"
+        )
+    if not np.all(np.isfinite(x0)):
+        raise ValueError(f"{who}: x0 has non-finite entries")
+    return x0
+
+
 def check_multiplier(multiplier, who: str) -> str:
     if multiplier not in MULTIPLIERS:
         raise ValueError(f"{who}: multiplier must be one of {MULTIPLIERS}, got {multiplier!r}")
@@ -218,16 +233,7 @@ def integrate(
         raise ValueError(
             f"integrate: t_end - t0 = {span:g} must be a whole multiple of save_dt = {save_dt:g}"
         )
-    if x0 is None:
-        x0 = model.reference_state(p)
-    x0 = np.array(x0, dtype=np.float64)
-    if x0.shape != (2 * model.n,):
-        raise ValueError(
-            f"integrate: x0 must have shape (2n,) = ({2 * model.n},) for model {model.name!r}, "
-            f"got {x0.shape}"
-        )
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("integrate: x0 has non-finite entries")
+    x0 = initial_state(model, x0, p, "integrate")
 
     multiplier = check_multiplier(multiplier, "integrate")
     bound = bind_law(law, model)
