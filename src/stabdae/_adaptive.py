@@ -22,6 +22,7 @@ from ._integrate import (
     _trajectory_dataset,
     check_multiplier,
     initial_state,
+    sample_writer,
 )
 from ._laws import as_law, bind_law
 from ._model import Model
@@ -45,7 +46,8 @@ def adaptive_for(model: Model, bound, multiplier: str = "ldl"):
 
 
 def _build_adaptive(K):
-    rhs, residual, energy, make_workspace = K.rhs, K.residual, K.energy, K.make_workspace
+    rhs, make_workspace = K.rhs, K.make_workspace
+    save = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
 
     @njit(error_model="numpy")
@@ -83,12 +85,7 @@ def _build_adaptive(K):
         t = t0
         nfev = 0
         # sample 0
-        residual(t, x, p, ws, g)
-        for l in range(N2):
-            out_x[0, l] = x[l]
-        for l in range(ng):
-            out_g[0, l] = g[l]
-        out_e[0] = energy(t, x, p, ws)
+        save(0, t, x, p, ws, g, out_x, out_g, out_e)
         st = f_eval(t, x, p, law_mat, law_scal, ws, k[0])
         nfev += 1
         if st != 0:
@@ -179,12 +176,7 @@ def _build_adaptive(K):
                 h = hh * fac if not hit else max(h, hh * fac)
                 if hit:
                     j += 1
-                    residual(t, x, p, ws, g)
-                    for l in range(N2):
-                        out_x[j, l] = x[l]
-                    for l in range(ng):
-                        out_g[j, l] = g[l]
-                    out_e[j] = energy(t, x, p, ws)
+                    save(j, t, x, p, ws, g, out_x, out_g, out_e)
             else:
                 rejected += 1
                 h = hh * max(0.2, 0.9 * e ** -0.2)

@@ -66,8 +66,27 @@ def check_multiplier(multiplier, who: str) -> str:
     return multiplier
 
 
+def sample_writer(K):
+    """``save(j, t, x, p, ws, g, out_x, out_g, out_e)``: state, residual and energy at ``t``
+    into row ``j`` of the outputs (inlined into the single-trajectory loops)."""
+    residual, energy = K.residual, K.energy
+    N2, ng = 2 * K.n, K.ng
+
+    @njit(inline="always")
+    def save(j, t, x, p, ws, g, out_x, out_g, out_e):
+        residual(t, x, p, ws, g)
+        for l in range(N2):
+            out_x[j, l] = x[l]
+        for l in range(ng):
+            out_g[j, l] = g[l]
+        out_e[j] = energy(t, x, p, ws)
+
+    return save
+
+
 def _build_stepper(K):
-    rhs, residual, energy, make_workspace = K.rhs, K.residual, K.energy, K.make_workspace
+    rhs, make_workspace = K.rhs, K.make_workspace
+    save = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
 
     @njit(error_model="numpy")
@@ -121,12 +140,7 @@ def _build_stepper(K):
                     return st, i - 1
                 t = t0 + i * tau  # from the step count, not accumulated
             if i % save_every == 0:
-                residual(t, x, p, ws, g)
-                for l in range(N2):
-                    out_x[j, l] = x[l]
-                for l in range(ng):
-                    out_g[j, l] = g[l]
-                out_e[j] = energy(t, x, p, ws)
+                save(j, t, x, p, ws, g, out_x, out_g, out_e)
                 j += 1
         return 0, nsteps
 

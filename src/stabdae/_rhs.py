@@ -92,7 +92,7 @@ def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kerne
     Memoized on the model, since every new closure is a new compilation.  Numeric law data
     (``A``, ``L``, gains) are runtime arguments, so sweeping them reuses the same kernels.
     """
-    key = (bound.code, bound.fn) if multiplier == "ldl" else (bound.code, bound.fn, multiplier)
+    key = (bound.code, bound.fn, multiplier)
     cache = model._kernel_cache
     if key not in cache:
         cache[key] = _build(model, bound.code, bound.fn, multiplier == "lstsq")

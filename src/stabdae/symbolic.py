@@ -50,6 +50,7 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
         "stabdae.symbolic needs sympy: pip install 'stabdae[symbolic]'"
     ) from exc
 
+from ._model import _PIECES
 from ._version import __version__
 
 __all__ = ["System", "SymbolicError", "coordinates", "t", "generate", "load_spec"]
@@ -381,12 +382,15 @@ class System:
 
 _IMPORTS = "import math\n\nimport numpy as np\nfrom numba import njit\n\nimport stabdae"
 
-_SIGNATURES = {
-    "mass": "t, q, p, out", "forces": "t, q, v, p, out", "f": "t, q, p, out",
-    "f_q": "t, q, p, out", "f_t": "t, q, p, out", "f_accel": "t, q, v, p, out",
-    "h": "t, q, v, p, out", "h_q": "t, q, v, p, out", "h_v": "t, q, v, p, out",
-    "h_t": "t, q, v, p, out", "energy": "t, q, v, p",
-}  # fmt: skip
+def _signature(piece: str) -> str:
+    """Arguments of a generated function, from the model's table of pieces."""
+    if piece == "energy":
+        return "t, q, v, p"
+    return ", ".join(_PIECES[piece][0]) + ", out"
+
+
+def _is_matrix(piece: str) -> bool:
+    return len(_PIECES[piece][1](1, 1, 1)) == 2
 
 _COMMENTS = {
     "mass": "M = ∂²L/∂v²",
@@ -454,7 +458,7 @@ class _LocalNames:
         prefix = "e"
         while any(n.startswith(prefix) and n[len(prefix):].isdigit() for n in self.taken):
             prefix += "_"
-        return sp.numbered_symbols(prefix), prefix
+        return sp.numbered_symbols(prefix)
 
     def code(self, expr) -> str:
         expr = sp.sympify(expr)
@@ -496,14 +500,14 @@ def _function(piece: str, expr, names: _LocalNames) -> str:
     else:
         M = expr
         targets, entries = [], []
-        matrix = M.shape[1] > 1 or piece in ("mass", "f_q", "h_q", "h_v")
+        matrix = _is_matrix(piece)
         for i in range(M.shape[0]):
             for j in range(M.shape[1]):
                 if piece == "mass" and j < i:
                     continue  # symmetric: the lower triangle is copied below
                 targets.append(f"out[{i}, {j}]" if matrix else f"out[{i}]")
                 entries.append(M[i, j])
-    symbols, _ = names.cse_symbols()
+    symbols = names.cse_symbols()
     nonzero = [(tg, e) for tg, e in zip(targets, entries) if e != 0]
     replacements, reduced = sp.cse([e for _, e in nonzero], symbols=symbols, order="canonical")
     used = set()
@@ -511,7 +515,7 @@ def _function(piece: str, expr, names: _LocalNames) -> str:
         used |= e.free_symbols
     body = names.unpack(used)
     for sym, value in replacements:
-        names.printer._rename[sym] = str(sym)
+        names.rename[sym] = str(sym)  # the printer reads the same mapping
         body.append(_assign(str(sym), names.code(value)))
     reduced_of = dict(zip([tg for tg, _ in nonzero], reduced))
     if piece == "energy":
@@ -531,7 +535,7 @@ def _function(piece: str, expr, names: _LocalNames) -> str:
                         body.append(f"out[{i}, {j}] = out[{j}, {i}]")
     comment = [f"# {_COMMENTS[piece]}"] if piece in _COMMENTS else []
     lines = comment + body
-    return (f"@njit\ndef {piece}({_SIGNATURES[piece]}):\n"
+    return (f"@njit\ndef {piece}({_signature(piece)}):\n"
             + "\n".join("    " + ln for ln in "\n".join(lines).splitlines()))  # fmt: skip
 
 
