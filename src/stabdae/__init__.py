@@ -8,7 +8,7 @@ from . import theory  # noqa: E402  (submodule: stabdae.theory)
 from ._adaptive import integrate_adaptive
 from ._ensemble import ensemble, sample_perturbations
 from ._integrate import IntegrationWarning, integrate
-from ._laws import Law, LawError, baumgarte, matrix, none, theorem5, user
+from ._laws import Law, LawError, acpr, baumgarte, matrix, none, theorem5, user
 from ._loading import load_model, scene_names
 from ._model import Model, ModelError
 from ._schemes import Scheme, SchemeError, dopri5, euler, heun, midpoint, rk4, two_stage
@@ -25,6 +25,7 @@ __all__ = [
     "SchemeError",
     "Status",
     "__version__",
+    "acpr",
     "baumgarte",
     "dopri5",
     "ensemble",

@@ -22,6 +22,7 @@ from ._integrate import (
     _trajectory_dataset,
     check_multiplier,
     initial_state,
+    projection_setting,
     sample_writer,
 )
 from ._laws import as_law, bind_law
@@ -46,7 +47,7 @@ def adaptive_for(model: Model, bound, multiplier: str = "ldl"):
 
 
 def _build_adaptive(K):
-    rhs, make_workspace = K.rhs, K.make_workspace
+    rhs, make_workspace, project = K.rhs, K.make_workspace, K.project
     save = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
 
@@ -67,11 +68,14 @@ def _build_adaptive(K):
 
     @njit(error_model="numpy")
     def adaptive_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
-                        tab_c, rtol, atol, h0, max_steps, out_x, out_g, out_e, counts):  # fmt: skip
+                        tab_c, rtol, atol, h0, max_steps, sweeps, tol, out_x, out_g, out_e,
+                        counts):  # fmt: skip
         """Integrate from ``x0`` at ``t0`` through every time in ``save_times`` (increasing,
         after ``t0``); sample ``j + 1`` is written at ``save_times[j]`` (sample 0 at ``t0``).
 
-        ``counts`` receives (accepted, rejected, rhs evaluations).  Returns
+        ``sweeps > 0`` projects the state after each accepted step (``K.project``; the
+        first stage of the next step is then evaluated anew).  ``counts`` receives
+        (accepted, rejected, rhs evaluations).  Returns
         ``(status, samples written)``; samples after a failure are left untouched.
         """
         ws = make_workspace()
@@ -169,6 +173,14 @@ def _build_adaptive(K):
                 for l in range(N2):
                     x[l] = xnew[l]
                     k[0, l] = k[s - 1, l]  # FSAL: the last stage is ẋ at the new point
+                if sweeps > 0:
+                    st = project(t, x, p, ws, sweeps, tol)
+                    if st == 0:
+                        st = f_eval(t, x, p, law_mat, law_scal, ws, k[0])
+                        nfev += 1
+                    if st != 0:
+                        counts[0], counts[1], counts[2] = accepted, rejected, nfev
+                        return st, j + 1
                 fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e ** -0.2))
                 if after_reject:
                     fac = min(fac, 1.0)
@@ -203,6 +215,7 @@ def integrate_adaptive(
     params=None,
     t0: float | None = None,
     multiplier: str = "ldl",
+    projection: str | None = None,
 ):
     """Integrate one trajectory of the stabilized equations with Dormand–Prince 5(4).
 
@@ -229,6 +242,9 @@ def integrate_adaptive(
     t0 : float, optional
     multiplier : {"ldl", "lstsq"}
         As for :func:`stabdae.integrate`: ``"lstsq"`` integrates redundant constraints.
+    projection : {None, "post", "full"}
+        As for :func:`stabdae.integrate`, after each accepted step (costs one more
+        right-hand-side evaluation per step: the first-same-as-last stage is lost).
 
     Returns
     -------
@@ -274,6 +290,7 @@ def integrate_adaptive(
 
     scheme = dopri5()
     multiplier = check_multiplier(multiplier, "integrate_adaptive")
+    sweeps, tol = projection_setting(projection, "integrate_adaptive")
     bound = bind_law(law, model)
     kernel = adaptive_for(model, bound, multiplier)
     nsave = save_times.shape[0] + 1
@@ -283,7 +300,7 @@ def integrate_adaptive(
     counts = np.zeros(3, dtype=np.int64)
     status, written = kernel(
         x0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
-        dopri5_embedded_weights(), scheme.c, rtol, atol, h0, int(max_steps),
+        dopri5_embedded_weights(), scheme.c, rtol, atol, h0, int(max_steps), sweeps, tol,
         out_x, out_g, out_e, counts,
     )  # fmt: skip
     status = Status(status)
@@ -299,7 +316,8 @@ def integrate_adaptive(
     ds = _trajectory_dataset(
         model, p, law, scheme, times, out_x, out_g, out_e, status, int(counts[0]),
         dict(method="dopri5", rtol=rtol, atol=atol, t0=t0, t_end=float(t_end),
-             steps=int(counts[0]), multiplier=multiplier),
+             steps=int(counts[0]), multiplier=multiplier,
+             projection=str(projection).lower()),
     )  # fmt: skip
     ds.attrs.update(
         steps_accepted=int(counts[0]), steps_rejected=int(counts[1]),

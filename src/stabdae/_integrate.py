@@ -14,7 +14,7 @@ from ._cache import kernel_key, keyed_cache
 from ._dataset import model_coords, provenance, variable
 from ._laws import as_law, bind_law
 from ._model import Model
-from ._rhs import MULTIPLIERS, kernels_for
+from ._rhs import MULTIPLIERS, PROJECTIONS, kernels_for
 from ._schemes import as_scheme
 from ._status import Status, status_flag_attrs
 
@@ -66,6 +66,15 @@ def check_multiplier(multiplier, who: str) -> str:
     return multiplier
 
 
+def projection_setting(projection, who: str) -> tuple[int, float]:
+    """``(sweeps, tolerance)`` of a ``projection`` argument (None, "post" or "full")."""
+    if projection not in PROJECTIONS:
+        raise ValueError(
+            f"{who}: projection must be None, 'post' or 'full', got {projection!r}"
+        )
+    return PROJECTIONS[projection]
+
+
 def sample_writer(K):
     """``save(j, t, x, p, ws, g, out_x, out_g, out_e)``: state, residual and energy at ``t``
     into row ``j`` of the outputs (inlined into the single-trajectory loops)."""
@@ -85,7 +94,7 @@ def sample_writer(K):
 
 
 def _build_stepper(K):
-    rhs, make_workspace = K.rhs, K.make_workspace
+    rhs, make_workspace, project = K.rhs, K.make_workspace, K.project
     save = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
 
@@ -119,8 +128,9 @@ def _build_stepper(K):
 
     @njit(error_model="numpy")
     def integrate_kernel(x0, t0, tau, nsteps, save_every, p, law_mat, law_scal,
-                         tab_a, tab_b, tab_c, out_x, out_g, out_e):  # fmt: skip
-        """Integrate from ``x0`` for ``nsteps`` steps, saving every ``save_every`` steps.
+                         tab_a, tab_b, tab_c, sweeps, tol, out_x, out_g, out_e):  # fmt: skip
+        """Integrate from ``x0`` for ``nsteps`` steps, saving every ``save_every`` steps;
+        after each step, ``sweeps > 0`` projects the state (``K.project``).
 
         Writes sample ``j`` (time ``t0 + j·save_every·τ``) into ``out_x[j]``, ``out_g[j]``
         and ``out_e[j]``; samples after a failure are left untouched.  Returns
@@ -139,6 +149,10 @@ def _build_stepper(K):
                 if st != 0:
                     return st, i - 1
                 t = t0 + i * tau  # from the step count, not accumulated
+                if sweeps > 0:
+                    st = project(t, x, p, ws, sweeps, tol)
+                    if st != 0:
+                        return st, i - 1
             if i % save_every == 0:
                 save(j, t, x, p, ws, g, out_x, out_g, out_e)
                 j += 1
@@ -183,6 +197,7 @@ def integrate(
     params=None,
     t0: float | None = None,
     multiplier: str = "ldl",
+    projection: str | None = None,
 ) -> xr.Dataset:
     """Integrate one trajectory of the stabilized equations (3.1), (3.11).
 
@@ -212,6 +227,11 @@ def integrate(
         How λ is solved from (3.11): ``"ldl"`` factorizes ``S`` and stops with status
         ``SINGULAR_S`` when it is singular (redundant constraints); ``"lstsq"`` takes the
         minimum-norm least-squares λ (pseudo-inverse of ``S``) and keeps integrating.
+    projection : {None, "post", "full"}
+        After each step: ``"post"`` applies one post-stabilization sweep
+        ``x ← x − D (G D)⁻¹ g(x)`` (positions, then velocities; Ascher et al.'s block
+        form), ``"full"`` repeats the sweeps until the residual stops shrinking (at most 8):
+        coordinate projection onto the manifold.  Usually combined with ``none()``.
 
     Returns
     -------
@@ -250,6 +270,7 @@ def integrate(
     x0 = initial_state(model, x0, p, "integrate")
 
     multiplier = check_multiplier(multiplier, "integrate")
+    sweeps, tol = projection_setting(projection, "integrate")
     bound = bind_law(law, model)
     kernel = integrator_for(model, bound, multiplier)
     nsave = nsteps // save_every + 1
@@ -258,7 +279,7 @@ def integrate(
     out_e = np.full(nsave, np.nan)
     status, done = kernel(
         x0, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
-        scheme.A, scheme.b, scheme.c, out_x, out_g, out_e,
+        scheme.A, scheme.b, scheme.c, sweeps, tol, out_x, out_g, out_e,
     )  # fmt: skip
     status = Status(status)
     if status != Status.OK:
@@ -272,7 +293,7 @@ def integrate(
     return _trajectory_dataset(
         model, p, law, scheme, times, out_x, out_g, out_e, status, done,
         dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=save_dt, steps=nsteps,
-             multiplier=multiplier),
+             multiplier=multiplier, projection=str(projection).lower()),
     )  # fmt: skip
 
 

@@ -22,12 +22,15 @@ from numba.core.dispatcher import Dispatcher
 
 from ._model import Model, ModelError, probe_output
 
-__all__ = ["Law", "BoundLaw", "baumgarte", "matrix", "theorem5", "none", "user", "as_law"]
+__all__ = [
+    "Law", "BoundLaw", "baumgarte", "matrix", "theorem5", "none", "user", "acpr", "as_law",
+]
 
 # Compile-time law kinds of the right-hand-side kernel.
 LAW_CONSTANT = 0  # A given as a runtime matrix
 LAW_THEOREM5 = 1  # A22 = −k W(x) L,  W = h_v h_vᵀ  (m = 0)
 LAW_USER = 2  # A(t, x, p, out) evaluated in the kernel
+LAW_ACPR = 3  # A = 0 plus the correction −γ_s D (G D)⁻¹ g of Ascher, Chin, Petzold, Reich
 
 
 class LawError(ValueError):
@@ -265,6 +268,41 @@ class UserLaw(Law):
         return {"law": self.kind, "function": getattr(self.fn, "__name__", "?")}
 
 
+@dataclass(frozen=True, repr=False)
+class ACPR(Law):
+    """Ascher–Chin–Petzold–Reich stabilization of the index-1 equations (DESIGN §3, end).
+
+    ``ẋ = ẋ₁(x) − γ_s D (G D)⁻¹ g(x)`` where ``ẋ₁`` is the right-hand side with ``A = 0``
+    and ``D (G D)⁻¹`` is taken in the block form of Ascher et al. for mechanical systems:
+    ``δq = M⁻¹f_qᵀ (f_q M⁻¹f_qᵀ)⁻¹ f`` and ``δv = M⁻¹Fᵀ S⁻¹ (ḟ, h)``.  The residual then
+    obeys ``ġ = −γ_s (I + N(x)) g`` with ``N`` strictly lower block-triangular (the
+    ``∂ḟ/∂q δq`` and ``∂h/∂q δq`` terms): every eigenvalue is ``−γ_s``, but it is not a
+    law ``ġ = Ã g`` with a constant ``Ã``.
+    """
+
+    gamma: float
+    kind: str = field(default="acpr", init=False)
+
+    @property
+    def is_constant(self) -> bool:
+        return False
+
+    def A(self, model: Model) -> np.ndarray:
+        raise LawError(
+            "acpr: the residual obeys ġ = −γ_s (I + N(x)) g, not a law ġ = Ã g of (3.9)"
+        )
+
+    def A_tilde(self, model: Model, x=None, t=None, p=None) -> np.ndarray:
+        return self.A(model)
+
+    def bind(self, model: Model) -> BoundLaw:
+        return BoundLaw(self, LAW_ACPR, np.zeros((model.r, model.n_residual)),
+                        np.array([self.gamma]))  # fmt: skip
+
+    def attrs(self) -> dict:
+        return {"law": self.kind, "gamma": self.gamma}
+
+
 # --------------------------------------------------------------------- constructors
 def _real(value, what: str, *, positive: bool = False, nonneg: bool = False) -> float:
     try:
@@ -338,6 +376,19 @@ def none() -> Law:
     return NoStabilization()
 
 
+def acpr(gamma: float) -> Law:
+    """The stabilization of Ascher, Chin, Petzold and Reich with gain ``γ_s > 0``.
+
+    ``ẋ = ẋ₁(x) − γ_s D (G D)⁻¹ g(x)`` on the index-1 equations (``A = 0``); see
+    :class:`ACPR`.  Needs ``multiplier="ldl"``.
+
+    Examples
+    --------
+    >>> law = acpr(50.0)
+    """
+    return ACPR(_real(gamma, "acpr: gamma", positive=True))
+
+
 def user(fn: Dispatcher) -> Law:
     """A state-dependent law ``A(t, x, p, out)``; ``out`` has shape (r, m + r)."""
     if not isinstance(fn, Dispatcher):
@@ -355,7 +406,7 @@ def as_law(law) -> Law:
     if isinstance(law, Dispatcher) or callable(law):
         return user(law)
     raise LawError(
-        f"law must be a stabdae law (baumgarte, matrix, theorem5, none, user) or an @njit "
+        f"law must be a stabdae law (baumgarte, matrix, theorem5, none, acpr, user) or an @njit "
         f"function A(t, x, p, out); got {type(law).__name__}"
     )
 

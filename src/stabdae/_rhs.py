@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from ._cache import fingerprint, optional_fingerprint, tag
-from ._laws import LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw
+from ._laws import LAW_ACPR, LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw, LawError
 from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace, pinv_solve_sym
 from ._model import Model
 from ._status import Status
@@ -67,9 +67,12 @@ def _nan_energy(t, q, v, p):
     return math.nan
 
 
-Kernels = namedtuple("Kernels", "rhs residual energy make_workspace n m k ng key")
+Kernels = namedtuple("Kernels", "rhs residual energy project make_workspace n m k ng key")
 Kernels.__doc__ = """The compiled pieces of one (model, law kind); ``key`` identifies what they
 were compiled from (:mod:`._cache`), ``None`` when a function has no source file."""
+
+#: projection after each step: name -> (sweeps per level, tolerance); see ``project``
+PROJECTIONS = {None: (0, 0.0), "post": (1, 0.0), "full": (8, 0.0)}
 
 
 def _rejit(fn, absent):
@@ -92,6 +95,11 @@ def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kerne
     Memoized on the model, since every new closure is a new compilation.  Numeric law data
     (``A``, ``L``, gains) are runtime arguments, so sweeping them reuses the same kernels.
     """
+    if bound.code == LAW_ACPR and multiplier != "ldl":
+        raise LawError(
+            f"acpr: the correction uses the L D Lᵀ factor of S; multiplier must be 'ldl', "
+            f"got {multiplier!r}"
+        )
     key = (bound.code, bound.fn, multiplier)
     cache = model._kernel_cache
     if key not in cache:
@@ -207,6 +215,9 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 for j in range(ng):
                     s += Aw[i, j] * g[j]
                 rl[i] = s
+        elif LAW == LAW_ACPR:  # the index-1 equations; the correction is added at the end
+            for i in range(r):
+                rl[i] = 0.0
         elif LAW == LAW_THEOREM5:  # m = 0: A22 g = −k W L g with W = h_v h_vᵀ
             for i in range(k):
                 s = 0.0
@@ -278,10 +289,89 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 s += Y[j, i] * rl[i]
             xdot[j] = v[j]
             xdot[n + j] = s
+        if LAW == LAW_ACPR:
+            # − γ_s (δq, δv): δv = Y S⁻¹ (ḟ, h); δq = Y₁ P⁻¹ f with P = f_q M⁻¹ f_qᵀ the
+            # leading m × m block of S, whose L D Lᵀ factor is the leading block of S's
+            mu = ws[18]
+            for i in range(m):
+                mu[i] = g[m + i]
+                sm[i] = g[i]
+            for i in range(k):
+                mu[m + i] = g[2 * m + i]
+            ldl_solve_inplace(S, r, mu)
+            ldl_solve_inplace(S, m, sm)
+            gam = law_scal[0]
+            for j in range(n):
+                dq = 0.0
+                for i in range(m):
+                    dq += Y[j, i] * sm[i]
+                dv = 0.0
+                for i in range(r):
+                    dv += Y[j, i] * mu[i]
+                xdot[j] -= gam * dq
+                xdot[n + j] -= gam * dv
         if bad_mass:
             return _MASS_NOT_SPD
         if bad_S:
             return _SINGULAR_S
+        return _OK
+
+    @njit(error_model="numpy")
+    def project(t, x, p, ws, sweeps, tol):
+        """Move ``x`` onto (towards) the manifold ``g = 0``, in place; return a status.
+
+        Positions first, then velocities at the corrected positions (the block form of
+        ``x ← x − D (G D)⁻¹ g`` of Ascher et al.), each level repeated until its residual
+        max-norm is ``≤ tol``, stops halving (the roundoff level) or ``sweeps``
+        corrections were made::
+
+            q ← q − M⁻¹f_qᵀ (f_q M⁻¹f_qᵀ)⁻¹ f          (Gauss–Newton in the M metric)
+            v ← v − M⁻¹Fᵀ S⁻¹ (ḟ, h)
+
+        One sweep with ``tol = 0`` is post-stabilization; sweeps to a small tolerance are
+        coordinate projection.
+        """
+        Mw, fq, hv, Y, S, g, sm, mu = ws[2], ws[4], ws[5], ws[7], ws[8], ws[10], ws[11], ws[18]
+        q = ws[0]
+        for level in range(2):
+            if (level == 0 and m == 0) or (level == 1 and r == 0):
+                continue
+            lo, cols = (0, m) if level == 0 else (m, r)
+            prev = math.inf
+            for _ in range(sweeps):
+                residual(t, x, p, ws, g)
+                err = 0.0
+                for i in range(cols):
+                    err = max(err, abs(g[lo + i]))
+                if err <= tol or err > 0.5 * prev:  # converged, or at the roundoff level
+                    break
+                prev = err
+                for i in range(cols):
+                    for j in range(n):
+                        Y[j, i] = fq[i, j] if i < m else hv[i - m, j]
+                if HAS_MASS:
+                    mass(t, q, p, Mw)
+                    if ldl_inplace(Mw, n, MASS_RTOL) != 0:
+                        return _MASS_NOT_SPD
+                    ldl_solve_columns(Mw, n, Y, cols)
+                for i in range(cols):
+                    for c in range(i + 1):
+                        s = 0.0
+                        for j in range(n):
+                            fij = fq[i, j] if i < m else hv[i - m, j]
+                            s += fij * Y[j, c]
+                        S[i, c] = s
+                if ldl_inplace(S, cols, S_RTOL) != 0:
+                    return _SINGULAR_S
+                rhs_ = sm if level == 0 else mu
+                for i in range(cols):
+                    rhs_[i] = g[lo + i]
+                ldl_solve_inplace(S, cols, rhs_)
+                for j in range(n):
+                    s = 0.0
+                    for i in range(cols):
+                        s += Y[j, i] * rhs_[i]
+                    x[level * n + j] -= s
         return _OK
 
     @njit(error_model="numpy")
@@ -298,5 +388,5 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
         *(("lstsq",) if lstsq else ()),
     )  # fmt: skip
-    tag(key, rhs, residual, energy, make_workspace)
-    return Kernels(rhs, residual, energy, make_workspace, n, m, k, ng, key)
+    tag(key, rhs, residual, energy, project, make_workspace)
+    return Kernels(rhs, residual, energy, project, make_workspace, n, m, k, ng, key)
