@@ -166,3 +166,61 @@ def test_ensemble_errors():
         stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=0)
     with pytest.raises(ValueError, match=r"x0 must have shape \(members, 2n\) = \(M, 4\)"):
         stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, x0=np.zeros((3, 3)))
+
+
+# ---------------------------------------------------------------- adaptive steps per member
+def test_adaptive_members_control_their_own_steps():
+    """Pendulums swinging at different amplitudes need different numbers of steps; each
+    member is bit-for-bit the single adaptive integration from its start."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    angles = np.array([0.1, 0.8, 1.6, 2.6])
+    x0 = np.stack([[np.sin(a), -np.cos(a), 0.0, 0.0] for a in angles])
+    kw = dict(rtol=1e-8, atol=1e-10, save_dt=0.5, residual_dtype="float64")
+    ds = stabdae.ensemble(model, law, tau=1e-3, t_end=2.0, x0=x0, **kw)
+    assert ds.attrs["method"] == "dopri5-adaptive" and ds.attrs["first_step"] == 1e-3
+    steps = ds.steps_accepted.values
+    assert len(set(steps.tolist())) == len(angles), steps  # every member its own count
+    for j in range(len(angles)):
+        one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, rtol=1e-8, atol=1e-10,
+                                         save_dt=0.5, first_step=1e-3)  # fmt: skip
+        assert one.attrs["steps_accepted"] == steps[j]
+        assert one.attrs["rhs_evaluations"] == ds.rhs_evaluations.values[j]
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+        np.testing.assert_array_equal(ds.residual_norm.values[j], one.residual_norm.values)
+
+
+def test_adaptive_ensemble_beta_and_determinism():
+    """Continuous-time decay: at tight tolerance the median fitted β is the Theorem 3 rate
+    (no discrete prediction is stored); one or two threads give the same numbers."""
+    model = load_scene("double_pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    kw = dict(tau=1e-3, t_end=3.0, members=64, radius=(1e-6, 1e-3), seed=5, save_dt=0.01,
+              rtol=1e-10, atol=1e-13)  # fmt: skip
+    a = stabdae.ensemble(model, law, threads=1, **kw)
+    b = stabdae.ensemble(model, law, threads=2, **kw)
+    assert abs(float(a.beta_median) / float(a.beta_theory) - 1.0) < 0.02
+    assert "beta_theory_discrete" not in a
+    for name in ("residual_norm", "x_final", "steps_accepted"):
+        np.testing.assert_array_equal(a[name].values, b[name].values)
+
+
+def test_adaptive_ensemble_isolates_divergence():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    good, _, _ = stabdae.sample_perturbations(model, 3, (1e-4, 1e-3), seed=1)
+    singular = np.array([0.0, 0.0, 0.1, 0.0])
+    kw = dict(tau=1e-3, t_end=0.5, rtol=1e-8, save_dt=0.05, residual_dtype="float64")
+    a = stabdae.ensemble(model, law, x0=np.vstack([good[:1], singular, good[1:]]), **kw)
+    b = stabdae.ensemble(model, law, x0=good, **kw)
+    np.testing.assert_array_equal(a.residual_norm.values[[0, 2, 3]], b.residual_norm.values)
+    assert a.status.values[1] == stabdae.Status.SINGULAR_S and a.diverged.values[1] == 1
+
+
+def test_adaptive_ensemble_errors():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    with pytest.raises(ValueError, match="scheme must be 'dopri5' or left out, got 'rk4'"):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, rtol=1e-6)
+    with pytest.raises(ValueError, match="atol is for adaptive steps; give rtol"):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, atol=1e-6)

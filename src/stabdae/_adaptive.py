@@ -35,6 +35,7 @@ __all__ = ["integrate_adaptive"]
 
 _STEP_TOO_SMALL = int(Status.STEP_TOO_SMALL)
 _MAX_STEPS = int(Status.MAX_STEPS)
+_DIVERGED = int(Status.DIVERGED)
 
 
 def adaptive_for(model: Model, bound, multiplier: str = "ldl"):
@@ -46,10 +47,31 @@ def adaptive_for(model: Model, bound, multiplier: str = "ldl"):
     return cache[key]
 
 
-def _build_adaptive(K):
-    rhs, make_workspace, project = K.rhs, K.make_workspace, K.project
-    save = sample_writer(K)
-    N2, ng = 2 * K.n, K.ng
+def adaptive_ensemble_for(model: Model, bound):
+    """The compiled per-member adaptive ensemble kernel (memoized)."""
+    key = ("adaptive-ensemble", bound.code, bound.fn)
+    cache = model._kernel_cache
+    if key not in cache:
+        cache[key] = _build_adaptive_ensemble(kernels_for(model, bound))
+    return cache[key]
+
+
+def _adaptive_loop(K, save, label: str):
+    """The Dormand–Prince loop of one trajectory, with ``save(j, t, x, p, ws, g, out)``
+    storing sample ``j`` (it returns True to stop the trajectory: status DIVERGED).
+
+    ``run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c, rtol, atol,
+    h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g, out, counts)`` integrates ``x`` in
+    place from ``t0`` through every time in ``save_times`` (increasing, after ``t0``);
+    sample ``j + 1`` is saved at ``save_times[j]`` (sample 0 at ``t0``).  ``sweeps > 0``
+    projects the state after each accepted step (``K.project``; the first stage of the
+    next step is then evaluated anew).  ``counts`` receives (accepted, rejected, rhs
+    evaluations).  Returns ``(status, samples written)``; on a failure ``x`` is the last
+    accepted state.  It allocates nothing: the buffers are the caller's.  ``label`` keeps
+    the symbol names of loops with different ``save`` functions apart (:func:`._cache.tag`).
+    """
+    rhs, project = K.rhs, K.project
+    N2 = 2 * K.n
 
     @njit(error_model="numpy")
     def f_eval(t, x, p, law_mat, law_scal, ws, xdot):
@@ -67,32 +89,18 @@ def _build_adaptive(K):
         return math.sqrt(s / N2)
 
     @njit(error_model="numpy")
-    def adaptive_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
-                        tab_c, rtol, atol, h0, max_steps, sweeps, tol, out_x, out_g, out_e,
-                        counts):  # fmt: skip
-        """Integrate from ``x0`` at ``t0`` through every time in ``save_times`` (increasing,
-        after ``t0``); sample ``j + 1`` is written at ``save_times[j]`` (sample 0 at ``t0``).
-
-        ``sweeps > 0`` projects the state after each accepted step (``K.project``; the
-        first stage of the next step is then evaluated anew).  ``counts`` receives
-        (accepted, rejected, rhs evaluations).  Returns
-        ``(status, samples written)``; samples after a failure are left untouched.
-        """
-        ws = make_workspace()
+    def run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c, rtol,
+            atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g, out, counts):  # fmt: skip
         s = tab_b.shape[0]
-        k = np.empty((s, N2))
-        xs = np.empty(N2)
-        xnew = np.empty(N2)
-        err = np.empty(N2)
-        g = np.empty(ng)
-        x = x0.copy()
         t = t0
         nfev = 0
-        # sample 0
-        save(0, t, x, p, ws, g, out_x, out_g, out_e)
+        counts[0], counts[1], counts[2] = 0, 0, 0
+        if save(0, t, x, p, ws, g, out):
+            return _DIVERGED, 1
         st = f_eval(t, x, p, law_mat, law_scal, ws, k[0])
         nfev += 1
         if st != 0:
+            counts[2] = nfev
             return st, 1
         # first step (Hairer–Nørsett–Wanner II.4): h from ‖x‖/‖ẋ‖, then from ‖ẍ‖
         h = h0
@@ -188,7 +196,9 @@ def _build_adaptive(K):
                 h = hh * fac if not hit else max(h, hh * fac)
                 if hit:
                     j += 1
-                    save(j, t, x, p, ws, g, out_x, out_g, out_e)
+                    if save(j, t, x, p, ws, g, out):
+                        counts[0], counts[1], counts[2] = accepted, rejected, nfev
+                        return _DIVERGED, j + 1
             else:
                 rejected += 1
                 h = hh * max(0.2, 0.9 * e ** -0.2)
@@ -196,9 +206,105 @@ def _build_adaptive(K):
         counts[0], counts[1], counts[2] = accepted, rejected, nfev
         return 0, nsave + 1
 
-    tag(K.key, f_eval)
+    tag(kernel_key(K.key, f"adaptive-loop-{label}"), f_eval, rms_error, run)
+    return run
+
+
+def save_grid(t0: float, t_end: float, save_dt) -> np.ndarray:
+    """Sample times after ``t0``: every ``save_dt``, the last one at ``t_end`` (only
+    ``t_end`` when ``save_dt`` is None)."""
+    if save_dt is None:
+        return np.array([t_end])
+    save_dt = _positive(save_dt, "save_dt")
+    count = max(1, int(math.ceil((t_end - t0) / save_dt - 1e-9)))
+    out = np.minimum(t0 + save_dt * np.arange(1, count + 1), t_end)
+    out[-1] = t_end
+    return out
+
+
+def _build_adaptive(K):
+    make_workspace = K.make_workspace
+    write = sample_writer(K)
+    N2, ng = 2 * K.n, K.ng
+
+    @njit(inline="always")
+    def save(j, t, x, p, ws, g, out):
+        write(j, t, x, p, ws, g, out[0], out[1], out[2])
+        return False
+
+    run = _adaptive_loop(K, save, "trajectory")
+
+    @njit(error_model="numpy")
+    def adaptive_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
+                        tab_c, rtol, atol, h0, max_steps, sweeps, tol, out_x, out_g, out_e,
+                        counts):  # fmt: skip
+        """One trajectory from ``x0``: the loop of :func:`_adaptive_loop` writing state,
+        residual and energy samples into ``out_x``, ``out_g``, ``out_e``."""
+        ws = make_workspace()
+        k = np.empty((tab_b.shape[0], N2))
+        xs, xnew, err, g = np.empty(N2), np.empty(N2), np.empty(N2), np.empty(ng)
+        x = x0.copy()
+        return run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c,
+                   rtol, atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g,
+                   (out_x, out_g, out_e), counts)  # fmt: skip
+
     keyed_cache(adaptive_kernel, kernel_key(K.key, "adaptive-dopri5"))
     return adaptive_kernel
+
+
+def _build_adaptive_ensemble(K):
+    make_workspace, residual, energy = K.make_workspace, K.residual, K.energy
+    N2, ng = 2 * K.n, K.ng
+
+    @njit(inline="always")
+    def save(j, t, x, p, ws, g, out):
+        norms, i, divergence = out
+        residual(t, x, p, ws, g)
+        r = 0.0
+        for l in range(ng):
+            r = max(r, abs(g[l]))
+        if not math.isfinite(r):
+            r = math.inf
+        norms[i, j] = r
+        return not (r <= divergence)
+
+    run = _adaptive_loop(K, save, "ensemble")
+
+    @njit(nogil=True, error_model="numpy")
+    def ensemble_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
+                        tab_c, rtol, atol, h0, max_steps, divergence, norms, x_final, status,
+                        fail_step, e0, e1, steps, nfev, lo, hi):  # fmt: skip
+        """Members ``lo … hi − 1``, each with its own step control; the buffers are
+        allocated once per call (a chunk of members), not per member."""
+        ws = make_workspace()
+        k = np.empty((tab_b.shape[0], N2))
+        xs, xnew, err, g = np.empty(N2), np.empty(N2), np.empty(N2), np.empty(ng)
+        x = np.empty(N2)
+        counts = np.zeros(3, dtype=np.int64)
+        tend = save_times[save_times.shape[0] - 1]
+        for i in range(lo, hi):
+            for l in range(N2):
+                x[l] = x0[i, l]
+            if status[i] != 0:  # not placed: keep it out
+                for l in range(N2):
+                    x_final[i, l] = x[l]
+                continue
+            e0[i] = energy(t0, x, p, ws)
+            st, written = run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
+                              tab_c, rtol, atol, h0, max_steps, 0, 0.0, ws, k, xs, xnew,
+                              err, g, (norms, i, divergence), counts)  # fmt: skip
+            for l in range(N2):
+                x_final[i, l] = x[l]
+            status[i] = st
+            steps[i] = counts[0]
+            nfev[i] = counts[2]
+            if st != 0:
+                fail_step[i] = counts[0]
+            else:
+                e1[i] = energy(tend, x, p, ws)
+
+    keyed_cache(ensemble_kernel, kernel_key(K.key, "adaptive-ensemble-dopri5"))
+    return ensemble_kernel
 
 
 def integrate_adaptive(
@@ -278,13 +384,7 @@ def integrate_adaptive(
     span = float(t_end) - t0
     if not (math.isfinite(span) and span > 0):
         raise ValueError(f"integrate_adaptive: t_end must be after t0 = {t0}, got {t_end!r}")
-    if save_dt is None:
-        save_times = np.array([float(t_end)])
-    else:
-        save_dt = _positive(save_dt, "save_dt")
-        count = max(1, int(math.ceil(span / save_dt - 1e-9)))
-        save_times = np.minimum(t0 + save_dt * np.arange(1, count + 1), float(t_end))
-        save_times[-1] = float(t_end)
+    save_times = save_grid(t0, float(t_end), save_dt)
     h0 = -1.0 if first_step is None else _positive(first_step, "first_step")
     x0 = initial_state(model, x0, p, "integrate_adaptive")
 

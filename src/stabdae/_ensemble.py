@@ -13,6 +13,7 @@ import time
 import numpy as np
 import xarray as xr
 
+from ._adaptive import adaptive_ensemble_for, save_grid
 from ._dataset import model_coords, provenance, variable
 from ._estimate import fit_decay
 from ._integrate import _positive, _whole_multiple
@@ -20,7 +21,7 @@ from ._laws import as_law, bind_law
 from ._model import Model
 from ._rhs import kernels_for
 from ._sampling import CHUNK, SAMPLING_RTOL, build_residual_rows, build_sampler, draw_alphas
-from ._schemes import as_scheme
+from ._schemes import as_scheme, dopri5, dopri5_embedded_weights
 from ._soa import BLOCK, build_soa_kernel
 from ._status import Status, status_flag_attrs
 from ._threads import default_threads, run_chunks
@@ -135,14 +136,32 @@ def _count(value, name: str) -> int:
     return int(value)
 
 
+def _fixed_step_grid(span: float, tau: float, save_dt) -> tuple[int, int]:
+    """(steps, steps between stored samples); default about 200 samples."""
+    nsteps = _whole_multiple(span, tau, "t_end - t0", "tau")
+    if save_dt is None:
+        save_every = max(1, nsteps // 200)
+        while nsteps % save_every:
+            save_every -= 1
+        return nsteps, save_every
+    save_every = _whole_multiple(_positive(save_dt, "save_dt"), tau, "save_dt", "tau")
+    if nsteps % save_every:
+        raise ValueError(
+            f"ensemble: t_end - t0 = {span:g} must be a whole multiple of save_dt = {save_dt:g}"
+        )
+    return nsteps, save_every
+
+
 # --------------------------------------------------------------------- driver
 def ensemble(
     model: Model,
     law,
-    scheme="rk2",
+    scheme=None,
     tau: float = 1e-3,
     t_end: float = 1.0,
     *,
+    rtol: float | None = None,
+    atol: float | None = None,
     members: int = 1024,
     radius=(1e-6, 1e-2),
     seed: int = 0,
@@ -162,10 +181,17 @@ def ensemble(
     ----------
     model : Model
     law : Law or @njit function
-    scheme : Scheme or str, default "rk2" (the midpoint rule)
+    scheme : Scheme or str, default "rk2" (the midpoint rule; "dopri5" with ``rtol``)
     tau, t_end, save_dt : float
         Fixed step, final time, spacing of stored residual norms (as in :func:`integrate`;
-        default ``save_dt``: about 200 samples).
+        default ``save_dt``: about 200 samples).  With ``rtol``, ``tau`` is every member's
+        first step and ``save_dt`` need not be a multiple of it.
+    rtol, atol : float, optional
+        Adaptive steps: each member controls its own step with the embedded Dormand–Prince
+        5(4) pair (as :func:`integrate_adaptive`) to these tolerances (``atol`` defaults
+        to ``rtol``).  The dataset then also has ``steps_accepted`` and
+        ``rhs_evaluations`` per member, and only the continuous-time prediction
+        ``beta_theory``.
     members : int
         Ensemble size (ignored when ``x0`` is given).
     radius : float or (low, high)
@@ -207,24 +233,29 @@ def ensemble(
     if not isinstance(model, Model):
         raise TypeError(f"ensemble: model must be a stabdae.Model, got {type(model).__name__}")
     law = as_law(law)
-    scheme = as_scheme(scheme)
+    adaptive = rtol is not None
+    if adaptive:
+        if scheme is not None and as_scheme(scheme).name != "dopri5":
+            raise ValueError(
+                f"ensemble: adaptive steps (rtol given) use the Dormand–Prince 5(4) pair; "
+                f"scheme must be 'dopri5' or left out, got {as_scheme(scheme).name!r}"
+            )
+        scheme = dopri5()
+        rtol = _positive(rtol, "rtol")
+        atol = rtol if atol is None else _positive(atol, "atol")
+    elif atol is not None:
+        raise ValueError("ensemble: atol is for adaptive steps; give rtol as well")
+    scheme = as_scheme("rk2" if scheme is None else scheme)
     p = model.param_vector(params)
     t0 = model.t0
     tau = _positive(tau, "tau")
     span = float(t_end) - t0
     if not (math.isfinite(span) and span > 0):
         raise ValueError(f"ensemble: t_end must be after t0 = {t0}, got t_end = {t_end!r}")
-    nsteps = _whole_multiple(span, tau, "t_end - t0", "tau")
-    if save_dt is None:
-        save_every = max(1, nsteps // 200)
-        while nsteps % save_every:
-            save_every -= 1
+    if adaptive:
+        save_times = save_grid(t0, float(t_end), span / 200 if save_dt is None else save_dt)
     else:
-        save_every = _whole_multiple(_positive(save_dt, "save_dt"), tau, "save_dt", "tau")
-        if nsteps % save_every:
-            raise ValueError(
-                f"ensemble: t_end - t0 = {span:g} must be a whole multiple of save_dt = {save_dt:g}"
-            )
+        nsteps, save_every = _fixed_step_grid(span, tau, save_dt)
     block = _count(block, "block")
     rdtype = np.dtype(residual_dtype) if str(residual_dtype) in ("float32", "float64") else None
     if rdtype is None:
@@ -253,16 +284,48 @@ def ensemble(
     M = x0.shape[0]
     wall_sample = time.perf_counter() - clock
 
-    nsave = nsteps // save_every + 1
+    nsave = save_times.shape[0] + 1 if adaptive else nsteps // save_every + 1
     norms = np.full((M, nsave), np.nan, dtype=rdtype)
     x_final = np.empty_like(x0)
     run_status = np.zeros(M, dtype=np.int8)
     fail_step = np.full(M, -1, dtype=np.int64)
     e0 = np.full(M, np.nan)
     e1 = np.full(M, np.nan)
+    x0c = np.ascontiguousarray(x0)
+    if adaptive:
+        steps = np.zeros(M, dtype=np.int64)
+        nfev = np.zeros(M, dtype=np.int64)
+        kernel = adaptive_ensemble_for(model, bound)
+        run_status[:] = status  # members that could not be placed stay out
+        clock = time.perf_counter()
+        run_chunks(
+            lambda lo, hi: kernel(
+                x0c, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
+                dopri5_embedded_weights(), scheme.c, rtol, atol, tau, 10_000_000,
+                divergence, norms, x_final, run_status, fail_step, e0, e1, steps, nfev,
+                lo, hi,
+            ),
+            M, threads=threads, progress=progress,
+        )  # fmt: skip
+        wall_integrate = time.perf_counter() - clock
+        status = np.where(status != 0, status, run_status).astype(np.int8)
+        times = np.concatenate([[t0], save_times])
+        clock = time.perf_counter()
+        ds = _ensemble_dataset(
+            model, p, law, scheme, bound, times, x0, alpha0, norms, x_final, status,
+            fail_step, e0, e1, epsilon,
+            dict(method="dopri5-adaptive", rtol=rtol, atol=atol, first_step=tau, tau=None,
+                 t0=t0, t_end=float(t_end), members=M, seed=seed, radius_low=low,
+                 radius_high=high, epsilon=epsilon, divergence=divergence,
+                 sampling_rtol=SAMPLING_RTOL,
+                 threads=threads if threads is not None else default_threads()),
+            extra={"steps_accepted": steps, "rhs_evaluations": nfev},
+        )  # fmt: skip
+        ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
+                        wall_fit_s=time.perf_counter() - clock)  # fmt: skip
+        return ds
     kernel = ensemble_kernel_for(model, bound, scheme.stages, block)
     clock = time.perf_counter()
-    x0c = np.ascontiguousarray(x0)
     run_chunks(
         lambda lo, hi: kernel(
             x0c, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,
@@ -291,7 +354,7 @@ def ensemble(
 
 
 def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_final,
-                      status, fail_step, e0, e1, epsilon, run):  # fmt: skip
+                      status, fail_step, e0, e1, epsilon, run, extra=None):  # fmt: skip
     ok = status == 0
     finite = np.isfinite(norms)
     nvalid = np.where(finite.all(axis=1), norms.shape[1], np.argmin(finite, axis=1))
@@ -330,6 +393,7 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
     }
     if model.energy is not None:
         values["energy_drift"] = e1 - e0
+    values.update(extra or {})
     values.update(_theory_values(law, model, p, scheme, run["tau"], x0, x_final, times, norms,
                                  alpha0, floor))  # fmt: skip
     data = {name: schema_variable(name, val) for name, val in values.items()}
@@ -337,7 +401,7 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
     data["residual_norm"].attrs["comment"] = (
         f"stored as {norms.dtype}; " + data["residual_norm"].attrs["comment"]
     )
-    attrs = provenance(model, p, law, scheme, **run)
+    attrs = provenance(model, p, law, scheme, **{k: v for k, v in run.items() if v is not None})
     attrs["residual_norm_dtype"] = str(norms.dtype)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
@@ -355,6 +419,8 @@ def _theory_values(law, model, p, scheme, tau, x0, x_final, times, norms, alpha0
     from . import theory
     from ._laws import Theorem5
 
+    if law.is_constant and tau is None:  # adaptive steps: only the continuous rate
+        return {"beta_theory": theory.continuous(law.A_tilde(model))["beta"]}
     if law.is_constant:
         return theory.predictions(model, law, scheme, tau)
     if not isinstance(law, Theorem5):
@@ -395,6 +461,8 @@ ENSEMBLE_SCHEMA = {
     "diverged_step": ("member", "step at which the member stopped (-1: ran to the end)", "1",
                       {}),
     "status": ("member", "member status", "1", {}),
+    "steps_accepted": ("member", "accepted steps (adaptive steps)", "1", {}),
+    "rhs_evaluations": ("member", "right-hand-side evaluations (adaptive steps)", "1", {}),
     "energy_drift": ("member", "energy change E(final) - E(x0)", "model units", {}),
     "fraction_bounded": ((), "fraction of bounded members", "1", {}),
     "stability_radius": ((), "largest |alpha0| below which every member is bounded", "1", {}),

@@ -1,0 +1,60 @@
+"""studies/work_precision.py at reduced size: one scene, three settings per ladder, every
+stabdae configuration and every peer (IDA when scikit-sundae is installed)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import xarray as xr
+
+from conftest import ROOT, load_file
+
+wp = load_file(ROOT / "studies" / "work_precision.py", "stabdae_study_work_precision")
+
+
+def test_cost_at_interpolates_log_log():
+    # errors 1e-4 at cost 1, 1e-8 at cost 100: 1e-6 is half way in log, cost 10
+    cost, how = wp.cost_at([1e-4, 1e-8], [1.0, 100.0])
+    assert how == "interpolated" and math.isclose(cost, 10.0, rel_tol=1e-12)
+    assert math.isnan(wp.cost_at([1e-3, 1e-4], [1.0, 2.0])[0])
+    assert wp.cost_at([1e-7, 1e-9], [3.0, 5.0]) == (3.0, "first run already below")
+
+
+def test_work_precision_study_runs(tmp_path):
+    summary = wp.main(["--scenes", "slider_crank", "--quick", "--out", str(tmp_path)])
+    with xr.open_dataset(tmp_path / "work_precision.nc") as ds:
+        ds = ds.load()
+    for name in ("wall_s", "rhs_evaluations", "error", "digits", "residual"):
+        assert ds[name].attrs["long_name"], name
+    methods = set(zip(ds.method.values.tolist(), ds.stabilization.values.tolist()))
+    for stab in wp.STABILIZATIONS:
+        for method in ("rk4", "dopri5", "dopri5-adaptive"):
+            assert (method, stab) in methods
+    for peer in ("scipy-DOP853", "scipy-Radau"):
+        assert (peer, "none") in methods and (peer, "projection") in methods
+    try:
+        import sksundae  # noqa: F401
+
+        assert ("sundials-IDA", "none") in methods
+    except ImportError:
+        pass
+    # every ladder gets more accurate as it gets more expensive …
+    for method, stab in methods:
+        mask = ((ds.method == method) & (ds.stabilization == stab)).values
+        err = ds.error.values[mask]
+        assert np.all(np.isfinite(err)), (method, stab)
+        assert err[-1] < err[0], (method, stab, err)
+    # … projections hold the residual at roundoff, the unstabilized runs drift
+    proj = ds.where((ds.stabilization == "projection") & (ds.method == "rk4"), drop=True)
+    none = ds.where((ds.stabilization == "none") & (ds.method == "rk4"), drop=True)
+    assert proj.residual.max() < 1e-12 < none.residual.min()
+    s = summary["slider_crank"]
+    assert s["best_stabdae"].split("/")[0] in ("rk4", "dopri5", "dopri5-adaptive")
+    for peer, v in s["peers"].items():
+        assert v["ratio_to_best_stabdae"] > 0, peer
+    saved = json.loads((tmp_path / "work_precision.json").read_text())
+    assert saved["at_target"]["slider_crank"]["best_stabdae"] == s["best_stabdae"]
+    assert (tmp_path / "work_precision_time.png").stat().st_size > 10_000
+    assert (tmp_path / "work_precision_evals.png").stat().st_size > 10_000
