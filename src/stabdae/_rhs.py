@@ -67,6 +67,26 @@ def _nan_energy(t, q, v, p):
     return math.nan
 
 
+@njit(cache=True, inline="always")
+def _load_Ft(fq, hv, Y, m, rows, n):
+    """``Y[:, :rows] = Fᵀ`` for the first ``rows`` rows of ``F = [f_q ; h_v]``."""
+    for i in range(rows):
+        for j in range(n):
+            Y[j, i] = fq[i, j] if i < m else hv[i - m, j]
+
+
+@njit(cache=True, inline="always")
+def _gram_lower(fq, hv, Y, S, m, rows, n):
+    """The lower triangle of ``S = F Y`` for the first ``rows`` rows of ``F``."""
+    for i in range(rows):
+        for c in range(i + 1):
+            s = 0.0
+            for j in range(n):
+                fij = fq[i, j] if i < m else hv[i - m, j]
+                s += fij * Y[j, c]
+            S[i, c] = s
+
+
 Kernels = namedtuple("Kernels", "rhs residual energy project make_workspace n m k ng key")
 Kernels.__doc__ = """The compiled pieces of one (model, law kind); ``key`` identifies what they
 were compiled from (:mod:`._cache`), ``None`` when a function has no source file."""
@@ -249,12 +269,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 rl[m + i] -= s
 
         # Y = M⁻¹ Fᵀ and z = M⁻¹ γ
-        for i in range(m):
-            for j in range(n):
-                Y[j, i] = fq[i, j]
-        for i in range(k):
-            for j in range(n):
-                Y[j, m + i] = hv[i, j]
+        _load_Ft(fq, hv, Y, m, r, n)
         # No early returns below: a failed factorization is remembered and reported at the
         # end, so that the ensemble kernel can inline this body into a vectorized loop.
         bad_mass = False
@@ -264,19 +279,14 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             ldl_solve_columns(Mw, n, Y, r)
             ldl_solve_inplace(Mw, n, z)
 
-        # S = F Y (symmetric; the lower triangle suffices for L D Lᵀ) and rl += F z
+        # rl += F z, and S = F Y (symmetric; the lower triangle suffices for L D Lᵀ)
         for i in range(r):
             s = 0.0
             for j in range(n):
                 fij = fq[i, j] if i < m else hv[i - m, j]
                 s += fij * z[j]
             rl[i] += s
-            for c in range(i + 1):
-                s = 0.0
-                for j in range(n):
-                    fij = fq[i, j] if i < m else hv[i - m, j]
-                    s += fij * Y[j, c]
-                S[i, c] = s
+        _gram_lower(fq, hv, Y, S, m, r, n)
         if LSTSQ:  # redundant constraints: the minimum-norm least-squares λ
             bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws[16], ws[17], ws[18]) == 0
         else:
@@ -346,21 +356,13 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 if err <= tol or err > 0.5 * prev:  # converged, or at the roundoff level
                     break
                 prev = err
-                for i in range(cols):
-                    for j in range(n):
-                        Y[j, i] = fq[i, j] if i < m else hv[i - m, j]
+                _load_Ft(fq, hv, Y, m, cols, n)
                 if HAS_MASS:
                     mass(t, q, p, Mw)
                     if ldl_inplace(Mw, n, MASS_RTOL) != 0:
                         return _MASS_NOT_SPD
                     ldl_solve_columns(Mw, n, Y, cols)
-                for i in range(cols):
-                    for c in range(i + 1):
-                        s = 0.0
-                        for j in range(n):
-                            fij = fq[i, j] if i < m else hv[i - m, j]
-                            s += fij * Y[j, c]
-                        S[i, c] = s
+                _gram_lower(fq, hv, Y, S, m, cols, n)
                 if ldl_inplace(S, cols, S_RTOL) != 0:
                     return _SINGULAR_S
                 rhs_ = sm if level == 0 else mu
