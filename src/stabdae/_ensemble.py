@@ -253,7 +253,8 @@ def ensemble(
     if not (math.isfinite(span) and span > 0):
         raise ValueError(f"ensemble: t_end must be after t0 = {t0}, got t_end = {t_end!r}")
     if adaptive:
-        save_times = save_grid(t0, float(t_end), span / 200 if save_dt is None else save_dt)
+        save_dt = span / 200 if save_dt is None else _positive(save_dt, "save_dt")
+        save_times = save_grid(t0, float(t_end), save_dt)
     else:
         nsteps, save_every = _fixed_step_grid(span, tau, save_dt)
     block = _count(block, "block")
@@ -292,12 +293,13 @@ def ensemble(
     e0 = np.full(M, np.nan)
     e1 = np.full(M, np.nan)
     x0c = np.ascontiguousarray(x0)
+    extra = None
+    clock = time.perf_counter()
     if adaptive:
         steps = np.zeros(M, dtype=np.int64)
         nfev = np.zeros(M, dtype=np.int64)
         kernel = adaptive_ensemble_for(model, bound)
         run_status[:] = status  # members that could not be placed stay out
-        clock = time.perf_counter()
         run_chunks(
             lambda lo, hi: kernel(
                 x0c, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
@@ -307,45 +309,35 @@ def ensemble(
             ),
             M, threads=threads, progress=progress,
         )  # fmt: skip
-        wall_integrate = time.perf_counter() - clock
-        status = np.where(status != 0, status, run_status).astype(np.int8)
         times = np.concatenate([[t0], save_times])
-        clock = time.perf_counter()
-        ds = _ensemble_dataset(
-            model, p, law, scheme, bound, times, x0, alpha0, norms, x_final, status,
-            fail_step, e0, e1, epsilon,
-            dict(method="dopri5-adaptive", rtol=rtol, atol=atol, first_step=tau, tau=None,
-                 t0=t0, t_end=float(t_end), members=M, seed=seed, radius_low=low,
-                 radius_high=high, epsilon=epsilon, divergence=divergence,
-                 sampling_rtol=SAMPLING_RTOL,
-                 threads=threads if threads is not None else default_threads()),
-            extra={"steps_accepted": steps, "rhs_evaluations": nfev},
+        extra = {"steps_accepted": steps, "rhs_evaluations": nfev}
+        run = dict(method="dopri5-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
+                   t_end=float(t_end), save_dt=save_dt)  # fmt: skip
+    else:
+        kernel = ensemble_kernel_for(model, bound, scheme.stages, block)
+        run_chunks(
+            lambda lo, hi: kernel(
+                x0c, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,
+                scheme.b, scheme.c, divergence, norms, x_final, run_status, fail_step, e0,
+                e1, lo, hi,
+            ),
+            -(-M // block), threads=threads,
+            progress=None if progress is None
+            else lambda done, _: progress(min(M, done * block), M),
         )  # fmt: skip
-        ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
-                        wall_fit_s=time.perf_counter() - clock)  # fmt: skip
-        return ds
-    kernel = ensemble_kernel_for(model, bound, scheme.stages, block)
-    clock = time.perf_counter()
-    run_chunks(
-        lambda lo, hi: kernel(
-            x0c, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,
-            scheme.b, scheme.c, divergence, norms, x_final, run_status, fail_step, e0, e1,
-            lo, hi,
-        ),
-        -(-M // block), threads=threads,
-        progress=None if progress is None else lambda done, _: progress(min(M, done * block), M),
-    )  # fmt: skip
+        times = t0 + tau * save_every * np.arange(nsave)
+        run = dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every,
+                   steps=nsteps)  # fmt: skip
     wall_integrate = time.perf_counter() - clock
     status = np.where(status != 0, status, run_status).astype(np.int8)
-    times = t0 + tau * save_every * np.arange(nsave)
     clock = time.perf_counter()
     ds = _ensemble_dataset(
         model, p, law, scheme, bound, times, x0, alpha0, norms, x_final, status, fail_step,
         e0, e1, epsilon,
-        dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every, steps=nsteps,
-             members=M, seed=seed, radius_low=low, radius_high=high, epsilon=epsilon,
+        dict(**run, members=M, seed=seed, radius_low=low, radius_high=high, epsilon=epsilon,
              divergence=divergence, sampling_rtol=SAMPLING_RTOL,
              threads=threads if threads is not None else default_threads()),
+        extra=extra,
     )  # fmt: skip
     # wall times (compilation included on a first call) for benchmarks; not part of the data
     ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
@@ -394,8 +386,8 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
     if model.energy is not None:
         values["energy_drift"] = e1 - e0
     values.update(extra or {})
-    values.update(_theory_values(law, model, p, scheme, run["tau"], x0, x_final, times, norms,
-                                 alpha0, floor))  # fmt: skip
+    values.update(_theory_values(law, model, p, scheme, run.get("tau"), x0, x_final, times,
+                                 norms, alpha0, floor))  # fmt: skip
     data = {name: schema_variable(name, val) for name, val in values.items()}
     data["status"].attrs.update(status_flag_attrs())
     data["residual_norm"].attrs["comment"] = (
