@@ -1,4 +1,6 @@
-"""One trajectory with an adaptive embedded Runge–Kutta pair (Dormand–Prince 5(4)).
+"""Adaptive steps with an embedded Runge–Kutta pair (Dormand–Prince 5(4)): one trajectory
+(:func:`integrate_adaptive`) and ensembles whose members each control their own step
+(``stabdae.ensemble(rtol=...)``), both running the one loop of :func:`_adaptive_loop`.
 
 For reference solutions and work–precision comparisons: the stabilized right-hand side
 (3.1), (3.11) integrated with local error control, ``err = ‖e / (atol + rtol·max(|x|,

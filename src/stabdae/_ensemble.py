@@ -2,7 +2,8 @@
 
 Layering (STYLE: driver over kernel): :func:`ensemble` validates, samples the
 perturbations (:mod:`._sampling`), calls the compiled block-lockstep kernel
-(:mod:`._soa`), fits decay rates (:mod:`._estimate`) and builds the dataset.
+(:mod:`._soa`) — or, with ``rtol``, the per-member adaptive kernel (:mod:`._adaptive`) —
+fits decay rates (:mod:`._estimate`) and builds the dataset.
 """
 
 from __future__ import annotations
