@@ -48,7 +48,7 @@ import platform
 import sys
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -82,7 +82,6 @@ class Scene:
     stabilizations: tuple = STABILIZATIONS
     peers: bool = True
     note: str = ""
-    extra: dict = field(default_factory=dict)
 
 
 SCENES = {
@@ -181,7 +180,10 @@ class Index1:
 
 
 def _dae_residual(model):
-    """``res(t, y, yp, out, p)`` of ``q' = v``, ``M v' − Fᵀλ + γ = 0``, ``F v' + c = 0``."""
+    """``res(t, y, yp, out, p)`` of ``q' = v``, ``M v' − Fᵀλ + γ = 0``, ``F v' + c = 0``.
+
+    Its small work arrays are allocated per call: passing preallocated buffers from Python
+    was slower (unboxing nine arrays per call: 1.71 against 1.04 µs on Andrews)."""
     n, m, k = model.n, model.m, model.k
     fns = model.functions
     HAS_MASS, HAS_HT = "mass" in fns, "h_t" in fns

@@ -394,7 +394,7 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
     data["residual_norm"].attrs["comment"] = (
         f"stored as {norms.dtype}; " + data["residual_norm"].attrs["comment"]
     )
-    attrs = provenance(model, p, law, scheme, **{k: v for k, v in run.items() if v is not None})
+    attrs = provenance(model, p, law, scheme, **run)
     attrs["residual_norm_dtype"] = str(norms.dtype)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
