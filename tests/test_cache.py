@@ -33,7 +33,8 @@ CHILD = textwrap.dedent(
     ds = stabdae.ensemble(model, law, "midpoint", tau=1e-3, t_end=0.2, members=8,
                           radius=(1e-5, 1e-4), seed=3)
     first = time.perf_counter() - clock
-    kernels = [sampler_for(model), ensemble_kernel_for(model, bind_law(law, model), 2, 64)]
+    kernels = [sampler_for(model),
+               ensemble_kernel_for(model, bind_law(law, model), stabdae.midpoint(), 64)]
     print(json.dumps(dict(
         hits=sum(sum(k.stats.cache_hits.values()) for k in kernels),
         misses=sum(sum(k.stats.cache_misses.values()) for k in kernels),

@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -224,3 +225,55 @@ def test_adaptive_ensemble_errors():
         stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, rtol=1e-6)
     with pytest.raises(ValueError, match="atol is for adaptive steps; give rtol"):
         stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, atol=1e-6)
+
+
+def _scheme(spec):
+    if isinstance(spec, str):
+        return spec
+    with warnings.catch_warnings():  # σ = 0 and σ = 2 are first order, and say so
+        warnings.simplefilter("ignore", UserWarning)
+        return stabdae.two_stage(*spec)
+
+
+@pytest.mark.parametrize("spec", ["euler", "midpoint", "rk4", "dopri5", (0.3, 0.0), (0.25, 2.0)])
+def test_every_tableau_pattern_equals_single_integrations(spec):
+    """The ensemble kernel is compiled per pattern of zero / one / other coefficients and
+    writes the stages out; its numbers are still those of ``integrate`` bit for bit
+    (σ = 0 has a zero weight, σ = 2 two general ones, dopri5 zeros inside A)."""
+    scheme = _scheme(spec)
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    ds = stabdae.ensemble(model, law, scheme, 2e-3, 0.2, members=3, seed=5, save_dt=0.02)
+    for j in range(3):
+        one = stabdae.integrate(model, ds.x0.values[j], law, scheme, 2e-3, 0.2, 0.02)
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+        np.testing.assert_array_equal(ds.residual_norm.values[j],
+                                      one.residual_norm.values.astype(np.float32))  # fmt: skip
+
+
+def test_members_stopped_mid_run_keep_their_last_good_state():
+    """Euler at τ = 0.25 with ω = 10 is unstable: every member grows until it stops, at a
+    step of its own, so the block loses its members one by one and ends with none running.
+    A member stopped at a stored sample (residual above the threshold) keeps that state;
+    one whose step overflowed keeps the state before that step.  Both equal ``integrate``
+    run up to that step, bit for bit."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    tau = 0.25
+    x0, _, _ = stabdae.sample_perturbations(model, 5, (1e-3, 1e-1), seed=3)
+    runs = {
+        stabdae.Status.DIVERGED: stabdae.ensemble(
+            model, law, "euler", tau, 250.0, x0=x0, save_dt=tau, epsilon=1.0, divergence=1e250
+        ),
+        stabdae.Status.NONFINITE_STATE: stabdae.ensemble(
+            model, law, "euler", tau, 250.0, x0=x0, save_dt=250.0, epsilon=1.0, divergence=1e300
+        ),
+    }
+    for status, ds in runs.items():
+        assert (ds.status.values == status).all(), status
+        steps = ds.diverged_step.values
+        assert len(set(steps.tolist())) > 1 and (steps > 0).all()
+        for j in range(5):
+            span = steps[j] * tau
+            one = stabdae.integrate(model, x0[j], law, "euler", tau, span, span)
+            np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])

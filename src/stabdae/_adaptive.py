@@ -229,7 +229,7 @@ def _build_adaptive(K):
     write = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
 
-    @njit(inline="always")
+    @njit(forceinline=True)
     def save(j, t, x, p, ws, g, out):
         write(j, t, x, p, ws, g, out[0], out[1], out[2])
         return False
@@ -258,7 +258,7 @@ def _build_adaptive_ensemble(K):
     make_workspace, residual, energy = K.make_workspace, K.residual, K.energy
     N2, ng = 2 * K.n, K.ng
 
-    @njit(inline="always")
+    @njit(forceinline=True)
     def save(j, t, x, p, ws, g, out):
         norms, i, divergence = out
         residual(t, x, p, ws, g)

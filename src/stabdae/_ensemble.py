@@ -23,7 +23,7 @@ from ._model import Model
 from ._rhs import kernels_for
 from ._sampling import CHUNK, SAMPLING_RTOL, build_residual_rows, build_sampler, draw_alphas
 from ._schemes import as_scheme, dopri5, dopri5_embedded_weights
-from ._soa import BLOCK, build_soa_kernel
+from ._soa import BLOCK, build_soa_kernel, tableau_pattern
 from ._status import Status, status_flag_attrs
 from ._threads import default_threads, run_chunks
 
@@ -53,10 +53,14 @@ def sampler_for(model: Model):
     return _memo(model, ("sampler",), lambda: build_sampler(_unstabilized(model)))
 
 
-def ensemble_kernel_for(model: Model, bound, stages: int, block: int):
-    """The block-lockstep ensemble kernel (memoized per law kind, stage count, block)."""
-    return _memo(model, ("ensemble", bound.code, bound.fn, stages, block),
-                 lambda: build_soa_kernel(kernels_for(model, bound), stages, block))  # fmt: skip
+def ensemble_kernel_for(model: Model, bound, scheme, block: int):
+    """The block-lockstep ensemble kernel (memoized per law kind, the kinds of the scheme's
+    coefficients, block and the shape of the law's matrix)."""
+    pattern = tableau_pattern(scheme)
+    shape = bound.matrix.shape
+    return _memo(model, ("ensemble", bound.code, bound.fn, pattern, block, shape),
+                 lambda: build_soa_kernel(kernels_for(model, bound), pattern, block,
+                                          len(model.param_vector(None)), shape))  # fmt: skip
 
 
 # --------------------------------------------------------------------- sampling
@@ -315,7 +319,7 @@ def ensemble(
         run = dict(method="dopri5-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
                    t_end=float(t_end), save_dt=save_dt)  # fmt: skip
     else:
-        kernel = ensemble_kernel_for(model, bound, scheme.stages, block)
+        kernel = ensemble_kernel_for(model, bound, scheme, block)
         run_chunks(
             lambda lo, hi: kernel(
                 x0c, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,

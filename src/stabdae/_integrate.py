@@ -81,7 +81,7 @@ def sample_writer(K):
     residual, energy = K.residual, K.energy
     N2, ng = 2 * K.n, K.ng
 
-    @njit(inline="always")
+    @njit(forceinline=True)
     def save(j, t, x, p, ws, g, out_x, out_g, out_e):
         residual(t, x, p, ws, g)
         for l in range(N2):
@@ -110,15 +110,17 @@ def _build_stepper(K):
             for l in range(N2):
                 acc = x[l]
                 for j in range(i):
-                    acc += tau * tab_a[i, j] * stages[j, l]
+                    if tab_a[i, j] != 0.0:  # as the ensemble kernel, which compiles them out
+                        acc += tau * tab_a[i, j] * stages[j, l]
                 xs[l] = acc
             st = rhs(t + tab_c[i] * tau, xs, p, law_mat, law_scal, ws, stages[i])
             if st != 0:
                 return st
         for l in range(N2):
-            acc = 0.0
+            acc = -0.0  # the exact identity of +, so the first term is taken as it is
             for i in range(s):
-                acc += tab_b[i] * stages[i, l]
+                if tab_b[i] != 0.0:
+                    acc += tab_b[i] * stages[i, l]
             xs[l] = x[l] + tau * acc
             if not math.isfinite(xs[l]):
                 return _NONFINITE

@@ -22,7 +22,7 @@ import math
 from numba import njit
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def ldl_inplace(a, n, rtol):
     """``a[:n, :n] = L D Lᵀ`` in place, for a symmetric positive definite matrix.
 
@@ -47,8 +47,8 @@ def ldl_inplace(a, n, rtol):
         ``0`` on success, otherwise ``j + 1`` for the first failing pivot ``j`` (the
         factor is then garbage and must not be used).
     """
-    dmax = 0.0
-    for i in range(n):
+    dmax = abs(a[0, 0])  # (n = 0 reads a spare entry that is never used)
+    for i in range(1, n):
         dmax = max(dmax, abs(a[i, i]))
     tol = rtol * dmax
     fail = 0
@@ -66,13 +66,16 @@ def ldl_inplace(a, n, rtol):
             ljp = w * a[p, p]
             d -= w * ljp
             a[j, p] = ljp
-        if fail == 0 and (not (d > tol) or not math.isfinite(d)):
+        # Non-finite pivots fail this test too: while the earlier pivots passed (d_p > 0)
+        # d ≤ a_jj, so d = +inf needs a_jj = +inf, and then tol = +inf; NaN and −inf
+        # compare false.  (One comparison per pivot: this sits in the vectorized loop.)
+        if fail == 0 and not (d > tol):
             fail = j + 1
         a[j, j] = 1.0 / d
     return fail
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def ldl_solve_inplace(l, n, b):
     """Solve ``L D Lᵀ x = b`` for one right-hand side, overwriting ``b[:n]`` with ``x``.
 
@@ -92,7 +95,7 @@ def ldl_solve_inplace(l, n, b):
         b[i] = s
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def ldl_solve_columns(l, n, b, ncols):
     """Solve ``L D Lᵀ X = B`` for the columns of ``b[:n, :ncols]``, in place."""
     for c in range(ncols):

@@ -20,6 +20,10 @@ behind branches on those constants, which LLVM removes: an identity-mass model c
 no factorization of ``M``, a model with ``k = 0`` no nonholonomic block, a scleronomic
 model no ``f_t`` call.  Every buffer lives in a workspace tuple allocated once per
 integration; an evaluation allocates nothing and returns a :class:`~stabdae.Status` code.
+
+Sums start from ``-0.0``, the exact identity of IEEE addition, so LLVM drops the start
+(``0.0 + x`` is not ``x`` for ``x = -0.0`` and would stay in the vectorized loop as one
+addition per sum).
 """
 
 from __future__ import annotations
@@ -52,12 +56,12 @@ _SINGULAR_S = int(Status.SINGULAR_S)
 _MASS_NOT_SPD = int(Status.MASS_NOT_SPD)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _noop4(a, b, c, out):  # stands in for an absent (t, q, p, out) piece
     pass
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _noop5(a, b, c, d, out):  # stands in for an absent (t, q, v, p, out) piece
     pass
 
@@ -67,7 +71,7 @@ def _nan_energy(t, q, v, p):
     return math.nan
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _load_Ft(fq, hv, Y, m, rows, n):
     """``Y[:, :rows] = Fᵀ`` for the first ``rows`` rows of ``F = [f_q ; h_v]``."""
     for i in range(rows):
@@ -75,12 +79,12 @@ def _load_Ft(fq, hv, Y, m, rows, n):
             Y[j, i] = fq[i, j] if i < m else hv[i - m, j]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _gram_lower(fq, hv, Y, S, m, rows, n):
     """The lower triangle of ``S = F Y`` for the first ``rows`` rows of ``F``."""
     for i in range(rows):
         for c in range(i + 1):
-            s = 0.0
+            s = -0.0
             for j in range(n):
                 fij = fq[i, j] if i < m else hv[i - m, j]
                 s += fij * Y[j, c]
@@ -101,12 +105,14 @@ def _rejit(fn, absent):
     ``error_model="numpy"`` drops the zero-division branches that a function compiled
     with the default error model keeps (they silently stop LLVM from vectorizing the
     ensemble kernel's member loop; a division by zero becomes inf/NaN and then a status),
-    and ``inline="always"`` inlines it at the numba IR level, so that the workspace
-    buffers it writes can live on the stack of the caller.
+    and ``forceinline=True`` marks it ``alwaysinline`` for LLVM, so that it disappears
+    into its callers and the workspace buffers it writes can live in registers.  (Not
+    ``inline="always"``: inlining at the numba IR level re-types the caller for every
+    call site and multiplied the ensemble kernel's compile time, see :mod:`._soa`.)
     """
     if fn is None:
         return absent
-    return njit(error_model="numpy", inline="always")(fn.py_func)
+    return njit(error_model="numpy", forceinline=True)(fn.py_func)
 
 
 def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kernels:
@@ -180,7 +186,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             np.empty(r),  # 18 scratch of size r
         )
 
-    @njit(inline="always")
+    @njit(forceinline=True)
     def residual(t, x, p, ws, g):
         """g = (f, f_q v + f_t, h) of (3.2) into ``g``; fills ws q, v, f_q, h_v, h_q."""
         q, v, fq, hv, hq, sm, sk = ws[0], ws[1], ws[4], ws[5], ws[6], ws[11], ws[12]
@@ -195,7 +201,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             if HAS_FT:
                 f_t(t, q, p, sm)
             for i in range(m):
-                s = sm[i] if HAS_FT else 0.0
+                s = sm[i] if HAS_FT else -0.0
                 for j in range(n):
                     s += fq[i, j] * v[j]
                 g[m + i] = s
@@ -206,7 +212,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             h_v(t, q, v, p, hv)
             h_q(t, q, v, p, hq)
 
-    @njit(inline="always", error_model="numpy")
+    @njit(forceinline=True, error_model="numpy")
     def rhs(t, x, p, law_mat, law_scal, ws, xdot):
         """Write ẋ of the stabilized system (3.1) into ``xdot``; return a status code.
 
@@ -224,34 +230,34 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         # after z = M⁻¹γ is known).
         if LAW == LAW_CONSTANT:
             for i in range(r):
-                s = 0.0
+                s = -0.0
                 for j in range(ng):
                     s += law_mat[i, j] * g[j]
                 rl[i] = s
         elif LAW == LAW_USER:
             law_A(t, x, p, Aw)
             for i in range(r):
-                s = 0.0
+                s = -0.0
                 for j in range(ng):
                     s += Aw[i, j] * g[j]
                 rl[i] = s
         elif LAW == LAW_ACPR:  # the index-1 equations; the correction is added at the end
             for i in range(r):
-                rl[i] = 0.0
+                rl[i] = -0.0
         elif LAW == LAW_THEOREM5:  # m = 0: A22 g = −k W L g with W = h_v h_vᵀ
             for i in range(k):
-                s = 0.0
+                s = -0.0
                 for j in range(k):
                     s += law_mat[i, j] * g[j]
                 Lh[i] = s
             for i in range(k):
                 for j in range(k):
-                    s = 0.0
+                    s = -0.0
                     for l in range(n):
                         s += hv[i, l] * hv[j, l]
                     W[i, j] = s
             for i in range(k):
-                s = 0.0
+                s = -0.0
                 for j in range(k):
                     s += W[i, j] * Lh[j]
                 rl[i] = -law_scal[0] * s
@@ -263,7 +269,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             if HAS_HT:
                 h_t(t, q, v, p, sk)
             for i in range(k):
-                s = sk[i] if HAS_HT else 0.0
+                s = sk[i] if HAS_HT else -0.0
                 for j in range(n):
                     s += hq[i, j] * v[j]
                 rl[m + i] -= s
@@ -281,7 +287,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
 
         # rl += F z, and S = F Y (symmetric; the lower triangle suffices for L D Lᵀ)
         for i in range(r):
-            s = 0.0
+            s = -0.0
             for j in range(n):
                 fij = fq[i, j] if i < m else hv[i - m, j]
                 s += fij * z[j]
@@ -294,11 +300,11 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             ldl_solve_inplace(S, r, rl)  # rl is now λ
 
         for j in range(n):
-            s = -z[j]
+            s = -0.0
             for i in range(r):
                 s += Y[j, i] * rl[i]
             xdot[j] = v[j]
-            xdot[n + j] = s
+            xdot[n + j] = s - z[j]
         if LAW == LAW_ACPR:
             # − γ_s (δq, δv): δv = Y S⁻¹ (ḟ, h); δq = Y₁ P⁻¹ f with P = f_q M⁻¹ f_qᵀ the
             # leading m × m block of S, whose L D Lᵀ factor is the leading block of S's
@@ -312,10 +318,10 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             ldl_solve_inplace(S, m, sm)
             gam = law_scal[0]
             for j in range(n):
-                dq = 0.0
+                dq = -0.0
                 for i in range(m):
                     dq += Y[j, i] * sm[i]
-                dv = 0.0
+                dv = -0.0
                 for i in range(r):
                     dv += Y[j, i] * mu[i]
                 xdot[j] -= gam * dq
@@ -370,7 +376,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                     rhs_[i] = g[lo + i]
                 ldl_solve_inplace(S, cols, rhs_)
                 for j in range(n):
-                    s = 0.0
+                    s = -0.0
                     for i in range(cols):
                         s += Y[j, i] * rhs_[i]
                     x[level * n + j] -= s

@@ -1,18 +1,33 @@
 """The ensemble kernel: blocks of members in lockstep, structure of arrays, member innermost.
 
 Each work item (a block; ranges of blocks run on threads, :mod:`._threads`) holds a block
-of ``BLOCK`` members as arrays ``X[state, member]`` and ``K[stage, state, member]``.  Every
-stage is one loop over the members of the block; its body is the whole stabilized
-right-hand side of one member (:mod:`._rhs`, the user's functions inlined) working on
-buffers that live on the stack (:func:`stack1`, :func:`stack2`).  With no heap arrays, no
-calls and no early exits left in the body, LLVM turns those buffers into registers and
-vectorizes the loop across members.
+of ``BLOCK`` members as arrays ``X[state, member]`` on the stack.  A step of the block is
+one loop over its members whose body is the member's whole explicit Runge–Kutta step
+(:func:`_member_step_source`): the stages written out, each a call of the stabilized
+right-hand side (:mod:`._rhs`, the user's functions inside), on buffers that live on the
+stack (:func:`stack1`, :func:`stack2`).  The step is generated for the scheme's pattern of
+zero / one / other coefficients (:func:`tableau_pattern`): zero terms are left out, factors
+one dropped, the values stay run-time arrays.
+
+Every function of the step is compiled once and marked ``alwaysinline`` for LLVM
+(``forceinline=True``) rather than inlined at the numba IR level (``inline="always"``):
+numba re-types the whole caller for each IR-inlined call site, which made the compile time
+grow with the number of stages (RK4 on the pendulum: 24 s against 3.8 s now), while LLVM
+inlines the compiled bodies in a fraction of that.  With no calls, no heap arrays and no
+early exits left in the loop body, and every array the loop touches an alloca that no
+other pointer reaches (the parameters, the law's numbers and the tableau are copied to the
+stack first), LLVM keeps the buffers in registers and vectorizes the member loop without
+run-time alias checks.
 
 Members never interact, so results are bit-for-bit the same for any thread count and any
-block size, and identical to :func:`stabdae.integrate` for the same initial state (same
-operations in the same order).  A member whose step fails (singular ``S``, mass not SPD,
-non-finite state) or whose residual exceeds the divergence threshold at a stored sample is
-frozen — its state no longer changes — and flagged; the other members are untouched.
+block size, and identical to :func:`stabdae.integrate` for the same initial state (the same
+operations in the same order: zero coefficients skipped in both, sums started from −0.0,
+``1 · k`` is ``k``).  A step reads one state buffer and writes the other, so the hot loop
+needs no masked store: a member whose step fails (singular ``S``, mass not SPD, non-finite
+state) or whose residual exceeds the divergence threshold at a stored sample keeps its
+last good state as its final state and is flagged, and its slot goes on with a copy of a
+running member (numbers nobody reads) so that it does not fail again at every step; the
+other members are untouched.
 """
 
 from __future__ import annotations
@@ -32,23 +47,30 @@ _NONFINITE = int(Status.NONFINITE_STATE)
 _DIVERGED = int(Status.DIVERGED)
 
 
-def _stack_array(context, builder, shape):
-    arrty = types.Array(types.float64, len(shape), "C")
+def _stack_array(context, builder, shape, dtype=types.float64):
+    arrty = types.Array(dtype, len(shape), "C")
     ary = context.make_array(arrty)(context, builder)
     size = 1
     for s in shape:
         size *= s
     # alloca_once puts the buffer in the entry block of the function being compiled: one
     # buffer per call site, reused by every iteration of the loop around it.
-    data = cgutils.alloca_once(builder, context.get_value_type(types.float64), size=max(size, 1))
+    data = cgutils.alloca_once(builder, context.get_value_type(dtype), size=max(size, 1))
+    item = context.get_abi_sizeof(context.get_value_type(dtype))
     intp = lambda v: context.get_constant(types.intp, v)  # noqa: E731
-    strides, acc = [], 8
+    strides, acc = [], item
     for s in reversed(shape):
         strides.insert(0, intp(acc))
         acc *= s
     context.populate_array(ary, data=data, shape=[intp(s) for s in shape], strides=strides,
-                           itemsize=intp(8), meminfo=None)  # fmt: skip
+                           itemsize=intp(item), meminfo=None)  # fmt: skip
     return ary._getvalue()
+
+
+def _literal_shape(*dims):
+    if not all(isinstance(d, types.IntegerLiteral) for d in dims):
+        return None
+    return tuple(d.literal_value for d in dims)
 
 
 @intrinsic
@@ -58,12 +80,12 @@ def stack1(typingctx, n):
     Only valid inside the function that calls it (inline the caller at the numba IR level
     if it is a helper).
     """
-    if not isinstance(n, types.IntegerLiteral):
+    shape = _literal_shape(n)
+    if shape is None:
         return None
-    size = n.literal_value
 
     def codegen(context, builder, sig, args):
-        return _stack_array(context, builder, (size,))
+        return _stack_array(context, builder, shape)
 
     return types.Array(types.float64, 1, "C")(n), codegen
 
@@ -71,9 +93,9 @@ def stack1(typingctx, n):
 @intrinsic
 def stack2(typingctx, n0, n1):
     """A C-ordered float64 array of compile-time shape ``(n0, n1)`` on the stack."""
-    if not (isinstance(n0, types.IntegerLiteral) and isinstance(n1, types.IntegerLiteral)):
+    shape = _literal_shape(n0, n1)
+    if shape is None:
         return None
-    shape = (n0.literal_value, n1.literal_value)
 
     def codegen(context, builder, sig, args):
         return _stack_array(context, builder, shape)
@@ -81,17 +103,100 @@ def stack2(typingctx, n0, n1):
     return types.Array(types.float64, 2, "C")(n0, n1), codegen
 
 
-def build_soa_kernel(K, stages: int, block: int = BLOCK):
-    """The block-lockstep ensemble kernel for the kernels ``K``, an ``stages``-stage explicit
-    scheme and blocks of ``block`` members (both fixed at compile time; the scheme's
-    coefficients are run-time arrays)."""
+@intrinsic
+def stack_int1(typingctx, n):
+    """An int64 array of compile-time length ``n`` on the stack."""
+    shape = _literal_shape(n)
+    if shape is None:
+        return None
+
+    def codegen(context, builder, sig, args):
+        return _stack_array(context, builder, shape, types.int64)
+
+    return types.Array(types.int64, 1, "C")(n), codegen
+
+
+def _kind(value: float) -> int:
+    return 0 if value == 0.0 else 1 if value == 1.0 else 2
+
+
+def tableau_pattern(scheme) -> tuple:
+    """The kind of each coefficient of an explicit scheme: ``(a, b)`` with ``a[s]`` the
+    kinds of ``A[s, :s]`` and ``b`` those of the weights; 0 for zero, 1 for one, 2 for
+    any other value.  The ensemble kernel is compiled for one pattern and leaves the
+    zero terms out and the multiplications by one (exact) away; the values stay run-time
+    arrays."""
+    A, b = np.asarray(scheme.A), np.asarray(scheme.b)
+    a = tuple(tuple(_kind(A[s, q]) for q in range(s)) for s in range(b.shape[0]))
+    return a, tuple(_kind(w) for w in b)
+
+
+def _member_step_source(pattern) -> str:
+    """Python source of one member's explicit Runge–Kutta step with the stages written
+    out, the zero terms of ``pattern`` left out and the factors equal to one dropped.
+
+    Written out rather than looped, so that the body has no inner loops left around the
+    inlined right-hand sides and the member loop around it vectorizes for any number of
+    stages (LLVM only vectorizes innermost loops and does not unroll a loop this large).
+    The results are those of :func:`stabdae._integrate` 's ``step`` bit for bit: it skips
+    the same zero terms, starts its sums from −0.0 (exact), and ``1.0 * x`` is ``x``.
+    """
+    a_kind, b_kind = pattern
+    stages = len(b_kind)
+
+    def a_term(s, q):  # (τ a_sq) k_q, as the loop of ``step`` computes it; τ · 1 is τ
+        return f"tau * k{q}[l]" if a_kind[s][q] == 1 else f"(tau * tab_a[{s}, {q}]) * k{q}[l]"
+
+    def b_term(s):  # b_s k_s; 1 · k is k
+        return f"k{s}[l]" if b_kind[s] == 1 else f"tab_b[{s}] * k{s}[l]"
+
+    lines = ["def member_step(t, xk, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, xs, xn):"]
+    lines += [f"    k{s} = stack1(N2)" for s in range(stages)]
+    for s in range(stages):
+        terms = [a_term(s, q) for q in range(s) if a_kind[s][q]]
+        arg = "xk"
+        if terms:
+            lines += ["    for l in range(N2):", f"        xs[l] = xk[l] + {' + '.join(terms)}"]
+            arg = "xs"
+        lines.append(
+            f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg}, p, law_mat, law_scal, ws, k{s})"
+        )
+    comb = " + ".join(b_term(s) for s in range(stages) if b_kind[s]) or "-0.0"
+    lines += [
+        "    finite = True",
+        "    for l in range(N2):",
+        f"        xn[l] = xk[l] + tau * ({comb})",
+        "        finite &= math.isfinite(xn[l])",
+        "    c = " + ("max(" + ", ".join(f"c{s}" for s in range(stages)) + ")"
+                     if stages > 1 else "c0"),
+        "    return _NONFINITE if (c == 0 and not finite) else c",
+    ]  # fmt: skip
+    return "\n".join(lines) + "\n"
+
+
+def _member_step(rhs, N2: int, pattern):
+    namespace = {"rhs": rhs, "stack1": stack1, "N2": N2, "math": math,
+                 "_NONFINITE": _NONFINITE}  # fmt: skip
+    exec(compile(_member_step_source(pattern), f"<stabdae step {pattern}>", "exec"), namespace)
+    return njit(forceinline=True, error_model="numpy")(namespace["member_step"])
+
+
+def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1)):
+    """The block-lockstep ensemble kernel for the kernels ``K``, an explicit scheme whose
+    coefficients are of the kinds ``pattern`` (:func:`tableau_pattern`), blocks of
+    ``block`` members, ``n_params`` parameters and a law matrix of shape ``law_shape``
+    (all fixed at compile time; the scheme's coefficients, the parameters and the law's
+    numbers are run-time arrays)."""
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
     n, m, k, ng = K.n, K.m, K.k, K.ng
     N2, r = 2 * n, m + k
     mk, kk = max(m, 1), max(k, 1)
-    S_ = stages
     B = block
+    S_ = len(pattern[1])
+    NP = max(n_params, 1)
+    LR, LC = law_shape
+    member_step = _member_step(rhs, N2, pattern)
 
     @njit(inline="always")
     def stack_workspace():
@@ -113,6 +218,22 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
             nrm = max(nrm, abs(g[l]))
         return nrm
 
+    @njit(error_model="numpy")
+    def retire(X_old, X_new, j, row, active, code, x_final):
+        """Stop slot ``j``.  Its member, output ``row`` (``-1``: padding, or a slot that
+        was already stopped), keeps ``X_old[:, j]`` as its final state; the slot then takes
+        the ``X_new`` state of a running member whose last step succeeded, so that it
+        computes harmless numbers from now on instead of failing at every step."""
+        if row >= 0:
+            for l in range(N2):
+                x_final[row, l] = X_old[l, j]
+        active[j] = False
+        for src in range(active.shape[0]):
+            if active[src] and code[src] == 0:
+                for l in range(N2):
+                    X_new[l, j] = X_new[l, src]
+                break
+
     @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a, tab_b, tab_c,
                    threshold, out_norm, x_final, status, fail_step, e0, e1,
@@ -121,86 +242,107 @@ def build_soa_kernel(K, stages: int, block: int = BLOCK):
         :func:`stabdae.ensemble`.  ``out_norm`` must be pre-filled (NaN): samples after a
         stop are not written.  Releases the GIL (run by :func:`._threads.run_chunks`)."""
         M = x0s.shape[0]
+        # The small run-time inputs copied to the stack, so that the loops read memory no
+        # store of theirs can touch (loads hoisted, no run-time alias checks).
+        p_s = stack1(NP)
+        for i in range(p.shape[0]):
+            p_s[i] = p[i]
+        lm = stack2(LR, LC)
+        for i in range(LR):
+            for j in range(LC):
+                lm[i, j] = law_mat[i, j]
+        ls = stack1(1)
+        ls[0] = law_scal[0]
+        ta = stack2(S_, S_)
+        tb = stack1(S_)
+        tc = stack1(S_)
+        for i in range(S_):
+            tb[i] = tab_b[i]
+            tc[i] = tab_c[i]
+            for j in range(S_):
+                ta[i, j] = tab_a[i, j]
+        # The block: two state buffers (a step reads Xa and writes Xb, so a failed step
+        # leaves the member's last good state in Xa) and the status of each slot's step.
+        Xa = stack2(N2, B)
+        Xb = stack2(N2, B)
+        code = stack_int1(B)
+        active = np.zeros(B, dtype=np.bool_)  # members (not padding) still running
+        ws_h = K_make_workspace()
+        g = np.empty(ng)
+        xs_h = np.empty(N2)
         for b in range(b_lo, b_hi):
             lo = b * B
             cnt = min(B, M - lo)
-            X = np.empty((N2, B))
-            Kst = np.empty((S_, N2, B))
-            code = np.zeros(B, dtype=np.int64)  # status of the current step, per member
-            active = np.ones(B, dtype=np.bool_)
-            ws_h = K_make_workspace()
-            g = np.empty(ng)
-            xs_h = np.empty(N2)
             for j in range(B):  # a short last block repeats its first member
                 src = lo + j if j < cnt else lo
+                code[j] = 0
+                active[j] = False
                 for l in range(N2):
-                    X[l, j] = x0s[src, l]
+                    Xa[l, j] = x0s[src, l]
+            alive = 0
             for j in range(cnt):
                 for l in range(N2):
-                    xs_h[l] = X[l, j]
+                    xs_h[l] = Xa[l, j]
                 e0[lo + j] = energy(t0, xs_h, p, ws_h)
-                nrm = save_sample(X, j, t0, p, ws_h, g, xs_h)
+                nrm = save_sample(Xa, j, t0, p, ws_h, g, xs_h)
                 out_norm[lo + j, 0] = nrm
+                active[j] = True
+                alive += 1
                 if not (nrm <= threshold):
-                    active[j] = False
                     status[lo + j] = _DIVERGED
                     fail_step[lo + j] = 0
+                    code[j] = 1  # not a source for the slots retired below
+            for j in range(cnt):
+                if code[j] != 0:
+                    alive -= 1
+                    retire(Xa, Xa, j, lo + j, active, code, x_final)
             for i in range(1, nsteps + 1):
+                if alive == 0:
+                    break
                 t = t0 + (i - 1) * tau
-                for s in range(S_):
-                    ts = t + tab_c[s] * tau
-                    for j in range(B):
-                        ws = stack_workspace()
-                        xs = stack1(N2)
-                        xd = stack1(N2)
-                        for l in range(N2):
-                            acc = X[l, j]
-                            for q in range(s):
-                                acc += tau * tab_a[s, q] * Kst[q, l, j]
-                            xs[l] = acc
-                        c = rhs(ts, xs, p, law_mat, law_scal, ws, xd)
-                        code[j] = c if s == 0 else max(code[j], c)
-                        for l in range(N2):
-                            Kst[s, l, j] = xd[l]
-                for j in range(B):
-                    # x_{k+1} = x_k + τ Σ b_s k_s, kept only for an active member whose
-                    # step succeeded and stayed finite (frozen members keep their state)
+                bad = False
+                for j in range(B):  # the whole step of every member
+                    ws = stack_workspace()
+                    xk = stack1(N2)
+                    xs = stack1(N2)
                     xn = stack1(N2)
-                    finite = True
                     for l in range(N2):
-                        acc = 0.0
-                        for s in range(S_):
-                            acc += tab_b[s] * Kst[s, l, j]
-                        xn[l] = X[l, j] + tau * acc
-                        finite &= math.isfinite(xn[l])
-                    c = code[j]
-                    c = _NONFINITE if (c == 0 and not finite) else c
+                        xk[l] = Xa[l, j]
+                    c = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn)
+                    for l in range(N2):
+                        Xb[l, j] = xn[l]
                     code[j] = c
-                    ok = active[j] and c == 0
-                    for l in range(N2):
-                        X[l, j] = xn[l] if ok else X[l, j]
-                for j in range(cnt):
-                    if active[j] and code[j] != 0:
-                        active[j] = False
-                        status[lo + j] = code[j]
-                        fail_step[lo + j] = i - 1
-                if i % save_every == 0:
+                    bad |= c != 0
+                if bad:  # rare: record the members whose step failed, recycle their slots
+                    for j in range(B):
+                        if code[j] != 0:
+                            row = lo + j if (j < cnt and active[j]) else -1
+                            if row >= 0:
+                                status[row] = code[j]
+                                fail_step[row] = i - 1
+                                alive -= 1
+                            retire(Xa, Xb, j, row, active, code, x_final)
+                Xa, Xb = Xb, Xa
+                if i % save_every == 0 and alive > 0:
                     tn = t0 + i * tau
                     for j in range(cnt):
                         if active[j]:
-                            nrm = save_sample(X, j, tn, p, ws_h, g, xs_h)
+                            nrm = save_sample(Xa, j, tn, p, ws_h, g, xs_h)
                             out_norm[lo + j, i // save_every] = nrm
                             if not (nrm <= threshold):
-                                active[j] = False
                                 status[lo + j] = _DIVERGED
                                 fail_step[lo + j] = i
+                                alive -= 1
+                                retire(Xa, Xa, j, lo + j, active, code, x_final)
             tf = t0 + nsteps * tau
             for j in range(cnt):
+                if active[j]:
+                    for l in range(N2):
+                        x_final[lo + j, l] = Xa[l, j]
                 for l in range(N2):
-                    x_final[lo + j, l] = X[l, j]
-                    xs_h[l] = X[l, j]
+                    xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
 
-    key = kernel_key(K.key, "soa", stages, block)
-    tag(key, stack_workspace, save_sample)
+    key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
+    tag(key, stack_workspace, save_sample, retire, member_step)
     return keyed_cache(soa_kernel, key)

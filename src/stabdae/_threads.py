@@ -32,8 +32,10 @@ def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None)
     """Call ``kernel(lo, hi)`` for consecutive ranges covering ``range(items)``.
 
     ``kernel`` must release the GIL (a ``nogil`` dispatcher called with arguments bound by
-    the caller).  ``progress(done, items)`` is called from the calling thread after each
-    chunk.  The first chunk runs alone, so that compilation happens once.
+    the caller) and do nothing for an empty range: ``kernel(0, 0)`` runs first, alone, so
+    that compilation (or loading from the cache) happens once, and then every chunk runs
+    on the pool.  ``progress(done, items)`` is called from the calling thread after each
+    chunk.
     """
     if items <= 0:
         return
@@ -41,23 +43,16 @@ def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None)
     threads = min(threads, items, os.cpu_count() or threads)
     chunks = _chunks(items, threads)
     done = 0
-    lo, hi = chunks[0]
-    kernel(lo, hi)
-    done += hi - lo
-    if progress is not None:
-        progress(done, items)
-    rest = chunks[1:]
-    if not rest:
-        return
     if threads == 1:
-        for lo, hi in rest:
+        for lo, hi in chunks:
             kernel(lo, hi)
             done += hi - lo
             if progress is not None:
                 progress(done, items)
         return
+    kernel(0, 0)
     with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="stabdae") as pool:
-        futures = [(hi - lo, pool.submit(kernel, lo, hi)) for lo, hi in rest]
+        futures = [(hi - lo, pool.submit(kernel, lo, hi)) for lo, hi in chunks]
         try:
             for size, fut in futures:
                 fut.result()
