@@ -277,3 +277,24 @@ def test_members_stopped_mid_run_keep_their_last_good_state():
             span = steps[j] * tau
             one = stabdae.integrate(model, x0[j], law, "euler", tau, span, span)
             np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+
+
+def test_trace_summary_matches_numpy():
+    """The one-pass summary of the stored traces gives NumPy's numbers: leading finite
+    samples, largest finite sample, last leading finite one (stops, inf, NaN rows)."""
+    from stabdae._estimate import trace_summary
+
+    norms = np.random.default_rng(0).random((40, 30)).astype(np.float32)
+    norms[3, 10:] = np.nan
+    norms[4, :] = np.nan
+    norms[5, 7], norms[5, 8:] = np.inf, np.nan
+    norms[6, 0] = np.nan
+    finite = np.isfinite(norms)
+    nvalid = np.where(finite.all(axis=1), norms.shape[1], np.argmin(finite, axis=1))
+    largest = np.where(nvalid > 0, np.nanmax(np.where(finite, norms, -np.inf), axis=1), np.nan)
+    last = norms[np.arange(40), np.maximum(nvalid - 1, 0)].astype(np.float64)
+    got = trace_summary(norms)
+    np.testing.assert_array_equal(got[0], nvalid)
+    np.testing.assert_array_equal(got[1], largest)
+    np.testing.assert_array_equal(got[2], last)
+    assert got[0][[3, 4, 5, 6]].tolist() == [10, 0, 7, 0]

@@ -16,7 +16,7 @@ import xarray as xr
 
 from ._adaptive import adaptive_ensemble_for, save_grid
 from ._dataset import model_coords, provenance, variable
-from ._estimate import fit_decay
+from ._estimate import fit_decay, trace_summary
 from ._integrate import _positive, _whole_multiple
 from ._laws import as_law, bind_law
 from ._model import Model
@@ -353,12 +353,9 @@ def ensemble(
 def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_final,
                       status, fail_step, e0, e1, epsilon, run, extra=None):  # fmt: skip
     ok = status == 0
-    finite = np.isfinite(norms)
-    nvalid = np.where(finite.all(axis=1), norms.shape[1], np.argmin(finite, axis=1))
+    nvalid, max_res, final = trace_summary(norms)
     beta, gamma, floor, _ = fit_decay(norms, times, nvalid)
     alpha_norm = np.max(np.abs(alpha0), axis=1)
-    max_res = np.where(nvalid > 0, np.nanmax(np.where(finite, norms, -np.inf), axis=1), np.nan)
-    final = norms[np.arange(norms.shape[0]), np.maximum(nvalid - 1, 0)].astype(np.float64)
     floor_ref = float(np.nanmedian(np.where(ok, floor, np.nan))) if ok.any() else np.nan
     decayed = ok & (final <= np.maximum(alpha_norm, DECAYED_FLOOR_FACTOR * floor_ref))
     bounded = ok & (max_res <= epsilon) & decayed

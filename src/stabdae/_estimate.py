@@ -246,6 +246,37 @@ def fit_decay_kernel(norms, nvalid, times, out):
             _fit_one(row, nvalid[j], times, env, on_env, tail, out[j])
 
 
+@njit(parallel=True, cache=True)
+def _trace_summary_kernel(norms, nvalid, largest, last):
+    M, T = norms.shape
+    for j in prange(M):
+        n = T
+        top = -math.inf
+        for i in range(T):
+            v = norms[j, i]
+            if math.isfinite(v):
+                top = max(top, v)
+            elif n == T:
+                n = i
+        nvalid[j] = n
+        largest[j] = top if n > 0 else math.nan
+        last[j] = norms[j, max(n - 1, 0)]
+
+
+def trace_summary(norms):
+    """Per trace, in one pass: the number of leading finite samples, the largest finite
+    sample (NaN when the first is not finite) and the last of the leading finite ones.
+
+    The same numbers as ``isfinite`` / ``argmin`` / ``nanmax`` over the whole array, which
+    made up most of the time spent after the integration of a large ensemble.
+    """
+    norms = np.ascontiguousarray(np.atleast_2d(norms))
+    M = norms.shape[0]
+    nvalid, largest, last = np.empty(M, dtype=np.int64), np.empty(M), np.empty(M)
+    _trace_summary_kernel(norms, nvalid, largest, last)
+    return nvalid, largest, last
+
+
 def fit_decay(norms, times, nvalid=None):
     """β, γ, floor and transient length for each trace.
 
@@ -265,8 +296,7 @@ def fit_decay(norms, times, nvalid=None):
     norms = np.ascontiguousarray(np.atleast_2d(norms))
     times = np.ascontiguousarray(times, dtype=np.float64)
     if nvalid is None:
-        finite = np.isfinite(norms)
-        nvalid = np.where(finite.all(axis=1), norms.shape[1], np.argmin(finite, axis=1))
+        nvalid = trace_summary(norms)[0]
     out = np.empty((norms.shape[0], 4))
     fit_decay_kernel(norms, np.ascontiguousarray(nvalid, dtype=np.int64), times, out)
     return out[:, 0], out[:, 1], out[:, 2], out[:, 3].astype(np.int64)
