@@ -245,7 +245,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         # The small run-time inputs copied to the stack, so that the loops read memory no
         # store of theirs can touch (loads hoisted, no run-time alias checks).
         p_s = stack1(NP)
-        for i in range(p.shape[0]):
+        for i in range(min(p.shape[0], NP)):  # (the driver passes exactly NP)
             p_s[i] = p[i]
         lm = stack2(LR, LC)
         for i in range(LR):
