@@ -16,6 +16,7 @@ import xarray as xr
 import stabdae
 from conftest import ROOT, load_scene
 from stabdae._dataset import write_netcdf
+from stabdae._soa import CHECKPOINT
 
 # ω = 1000 with τω = 0.1: the residual decays over several decades before the truncation
 # floor, and the discrete rate −ln ρ(R(τÃ))/τ differs from the continuous ω (Euler: 5 %).
@@ -273,6 +274,8 @@ def test_members_stopped_mid_run_keep_their_last_good_state():
         assert (ds.status.values == status).all(), status
         steps = ds.diverged_step.values
         assert len(set(steps.tolist())) > 1 and (steps > 0).all()
+        if status == stabdae.Status.NONFINITE_STATE:  # the last good state was replayed
+            assert ((steps > CHECKPOINT) & (steps % CHECKPOINT > 1)).any(), steps
         for j in range(5):
             span = steps[j] * tau
             one = stabdae.integrate(model, x0[j], law, "euler", tau, span, span)

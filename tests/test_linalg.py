@@ -58,3 +58,19 @@ def test_pinv_solve_sym_matches_numpy_pinv(n, rank):
     r = pinv_solve_sym(a, n, got, 1e-10, np.empty((n, n)), np.empty(n), np.empty(n))
     assert r == rank
     assert np.max(np.abs(got - want)) <= 1e-12 * np.max(np.abs(want))
+
+
+def test_fma_rounds_once_where_the_host_has_fma():
+    """(1 + 2⁻³⁰)² − (1 + 2⁻²⁹) = 2⁻⁶⁰ exactly; multiply-then-add rounds the square to
+    1 + 2⁻²⁹ and gives 0.  Without FMA hardware ``fma`` is that multiply-then-add."""
+    from numba import njit
+
+    from stabdae._fma import HOST_FMA, fma
+
+    @njit
+    def f(a, b, c):
+        return fma(a, b, c)
+
+    a = 1.0 + 2.0**-30
+    assert f(a, a, -(1.0 + 2.0**-29)) == (2.0**-60 if HOST_FMA else 0.0)
+    assert f(3, 2.0, 1.0) == 7.0  # integers are converted

@@ -142,10 +142,12 @@ def test_affine_constraints_follow_R_power_exactly():
         got = ds.residual_norm.values
         # relative to each member's largest residual: the sequence first grows ~ω·f (the
         # velocity residual picks up the position residual), and roundoff in g(x) is
-        # absolute, at the level of that peak
+        # absolute, at the level of that peak.  Measured: ~1e-11 absolute, up to 1.3e-10 of
+        # the peak for the member with the smallest one (0.99e-10 before the library's
+        # multiply-adds were fused); a wrong rate or step shows at 1e-4 and above.
         scale = pred.max(axis=1, keepdims=True)
         err = np.abs(got - pred) / scale
-        assert err.max() <= 1e-10, err.max()
+        assert err.max() <= 5e-10, err.max()
         rho = theory.spectral_radius(R)
         if factor < 1:
             assert rho < 1 and (got[:, -1] < got[:, 0]).all()

@@ -69,7 +69,10 @@ def clear() -> None:
 
 @cache
 def _library_fingerprint() -> str:
-    h = hashlib.sha256(f"numba {numba.__version__} py {sys.version_info[:2]}".encode())
+    from ._fma import HOST_FMA  # the library's multiply-adds compile differently without FMA
+
+    text = f"numba {numba.__version__} py {sys.version_info[:2]} fma {HOST_FMA}"
+    h = hashlib.sha256(text.encode())
     for path in sorted(Path(__file__).parent.glob("*.py")):
         h.update(path.name.encode())
         h.update(path.read_bytes())

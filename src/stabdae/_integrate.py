@@ -12,6 +12,7 @@ from numba import njit
 
 from ._cache import kernel_key, keyed_cache
 from ._dataset import model_coords, provenance, variable
+from ._fma import fma
 from ._laws import as_law, bind_law
 from ._model import Model
 from ._rhs import MULTIPLIERS, PROJECTIONS, kernels_for
@@ -111,7 +112,7 @@ def _build_stepper(K):
                 acc = x[l]
                 for j in range(i):
                     if tab_a[i, j] != 0.0:  # as the ensemble kernel, which compiles them out
-                        acc += tau * tab_a[i, j] * stages[j, l]
+                        acc = fma(tau * tab_a[i, j], stages[j, l], acc)
                 xs[l] = acc
             st = rhs(t + tab_c[i] * tau, xs, p, law_mat, law_scal, ws, stages[i])
             if st != 0:
@@ -120,8 +121,8 @@ def _build_stepper(K):
             acc = -0.0  # the exact identity of +, so the first term is taken as it is
             for i in range(s):
                 if tab_b[i] != 0.0:
-                    acc += tab_b[i] * stages[i, l]
-            xs[l] = x[l] + tau * acc
+                    acc = fma(tab_b[i], stages[i, l], acc)
+            xs[l] = fma(tau, acc, x[l])
             if not math.isfinite(xs[l]):
                 return _NONFINITE
         for l in range(N2):

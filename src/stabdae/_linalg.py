@@ -21,6 +21,8 @@ import math
 
 from numba import njit
 
+from ._fma import fma
+
 
 @njit(cache=True, error_model="numpy", forceinline=True)
 def ldl_inplace(a, n, rtol):
@@ -57,20 +59,22 @@ def ldl_inplace(a, n, rtol):
         for p in range(j):
             s = a[j, p]
             for q in range(p):
-                s -= a[j, q] * a[p, q]
+                s = fma(-a[j, q], a[p, q], s)
             a[j, p] = s
         # … then L_jp = w_p / d_p and d_j = a_jj − Σ_p w_p L_jp
         d = a[j, j]
         for p in range(j):
             w = a[j, p]
             ljp = w * a[p, p]
-            d -= w * ljp
+            d = fma(-w, ljp, d)
             a[j, p] = ljp
         # Non-finite pivots fail this test too: while the earlier pivots passed (d_p > 0)
         # d ≤ a_jj, so d = +inf needs a_jj = +inf, and then tol = +inf; NaN and −inf
-        # compare false.  (One comparison per pivot: this sits in the vectorized loop.)
-        if fail == 0 and not (d > tol):
-            fail = j + 1
+        # compare false.  (One comparison per pivot, and arithmetic instead of a branch to
+        # keep the first failing pivot: this sits in the vectorized member loop, where a
+        # chain of branches on ``fail`` stopped LLVM from vectorizing it for n ≥ 2.)
+        bad = not (d > tol)
+        fail += (j + 1) * (bad & (fail == 0))
         a[j, j] = 1.0 / d
     return fail
 
@@ -84,14 +88,14 @@ def ldl_solve_inplace(l, n, b):
     for i in range(n):  # L y = b
         s = b[i]
         for p in range(i):
-            s -= l[i, p] * b[p]
+            s = fma(-l[i, p], b[p], s)
         b[i] = s
     for i in range(n):  # D z = y
         b[i] *= l[i, i]
     for i in range(n - 1, -1, -1):  # Lᵀ x = z
         s = b[i]
         for p in range(i + 1, n):
-            s -= l[p, i] * b[p]
+            s = fma(-l[p, i], b[p], s)
         b[i] = s
 
 
@@ -102,14 +106,14 @@ def ldl_solve_columns(l, n, b, ncols):
         for i in range(n):
             s = b[i, c]
             for p in range(i):
-                s -= l[i, p] * b[p, c]
+                s = fma(-l[i, p], b[p, c], s)
             b[i, c] = s
         for i in range(n):
             b[i, c] *= l[i, i]
         for i in range(n - 1, -1, -1):
             s = b[i, c]
             for p in range(i + 1, n):
-                s -= l[p, i] * b[p, c]
+                s = fma(-l[p, i], b[p, c], s)
             b[i, c] = s
 
 

@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit
 
 from ._cache import fingerprint, optional_fingerprint, tag
+from ._fma import fma
 from ._laws import LAW_ACPR, LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw, LawError
 from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace, pinv_solve_sym
 from ._model import Model
@@ -87,7 +88,7 @@ def _gram_lower(fq, hv, Y, S, m, rows, n):
             s = -0.0
             for j in range(n):
                 fij = fq[i, j] if i < m else hv[i - m, j]
-                s += fij * Y[j, c]
+                s = fma(fij, Y[j, c], s)
             S[i, c] = s
 
 
@@ -203,7 +204,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             for i in range(m):
                 s = sm[i] if HAS_FT else -0.0
                 for j in range(n):
-                    s += fq[i, j] * v[j]
+                    s = fma(fq[i, j], v[j], s)
                 g[m + i] = s
         if k > 0:
             h_fn(t, q, v, p, sk)
@@ -226,53 +227,51 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         residual(t, x, p, ws, g)
         forces(t, q, v, p, z)
 
-        # Right side of (3.11): A g − c + F z (z = γ for now; the F z term is added below,
-        # after z = M⁻¹γ is known).
+        # Right side of (3.11): A g − c + F z.  First −c, the convective terms; then the
+        # law's A g is added (fused multiply-adds), and F z below, once z = M⁻¹γ is known.
+        if m > 0:
+            f_accel(t, q, v, p, sm)
+            for i in range(m):
+                rl[i] = -sm[i]
+        if k > 0:
+            if HAS_HT:
+                h_t(t, q, v, p, sk)
+            for i in range(k):
+                s = -sk[i] if HAS_HT else -0.0
+                for j in range(n):
+                    s = fma(-hq[i, j], v[j], s)
+                rl[m + i] = s
         if LAW == LAW_CONSTANT:
             for i in range(r):
-                s = -0.0
+                s = rl[i]
                 for j in range(ng):
-                    s += law_mat[i, j] * g[j]
+                    s = fma(law_mat[i, j], g[j], s)
                 rl[i] = s
         elif LAW == LAW_USER:
             law_A(t, x, p, Aw)
             for i in range(r):
-                s = -0.0
+                s = rl[i]
                 for j in range(ng):
-                    s += Aw[i, j] * g[j]
+                    s = fma(Aw[i, j], g[j], s)
                 rl[i] = s
-        elif LAW == LAW_ACPR:  # the index-1 equations; the correction is added at the end
-            for i in range(r):
-                rl[i] = -0.0
         elif LAW == LAW_THEOREM5:  # m = 0: A22 g = −k W L g with W = h_v h_vᵀ
             for i in range(k):
                 s = -0.0
                 for j in range(k):
-                    s += law_mat[i, j] * g[j]
+                    s = fma(law_mat[i, j], g[j], s)
                 Lh[i] = s
             for i in range(k):
                 for j in range(k):
                     s = -0.0
                     for l in range(n):
-                        s += hv[i, l] * hv[j, l]
+                        s = fma(hv[i, l], hv[j, l], s)
                     W[i, j] = s
             for i in range(k):
                 s = -0.0
                 for j in range(k):
-                    s += W[i, j] * Lh[j]
-                rl[i] = -law_scal[0] * s
-        if m > 0:
-            f_accel(t, q, v, p, sm)
-            for i in range(m):
-                rl[i] -= sm[i]
-        if k > 0:
-            if HAS_HT:
-                h_t(t, q, v, p, sk)
-            for i in range(k):
-                s = sk[i] if HAS_HT else -0.0
-                for j in range(n):
-                    s += hq[i, j] * v[j]
-                rl[m + i] -= s
+                    s = fma(W[i, j], Lh[j], s)
+                rl[i] = fma(-law_scal[0], s, rl[i])
+        # (LAW_ACPR: the index-1 equations, A g = 0; its correction is added at the end)
 
         # Y = M⁻¹ Fᵀ and z = M⁻¹ γ
         _load_Ft(fq, hv, Y, m, r, n)
@@ -287,11 +286,11 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
 
         # rl += F z, and S = F Y (symmetric; the lower triangle suffices for L D Lᵀ)
         for i in range(r):
-            s = -0.0
+            s = rl[i]
             for j in range(n):
                 fij = fq[i, j] if i < m else hv[i - m, j]
-                s += fij * z[j]
-            rl[i] += s
+                s = fma(fij, z[j], s)
+            rl[i] = s
         _gram_lower(fq, hv, Y, S, m, r, n)
         if LSTSQ:  # redundant constraints: the minimum-norm least-squares λ
             bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws[16], ws[17], ws[18]) == 0
@@ -300,11 +299,11 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             ldl_solve_inplace(S, r, rl)  # rl is now λ
 
         for j in range(n):
-            s = -0.0
+            s = -z[j]
             for i in range(r):
-                s += Y[j, i] * rl[i]
+                s = fma(Y[j, i], rl[i], s)
             xdot[j] = v[j]
-            xdot[n + j] = s - z[j]
+            xdot[n + j] = s
         if LAW == LAW_ACPR:
             # − γ_s (δq, δv): δv = Y S⁻¹ (ḟ, h); δq = Y₁ P⁻¹ f with P = f_q M⁻¹ f_qᵀ the
             # leading m × m block of S, whose L D Lᵀ factor is the leading block of S's
@@ -320,17 +319,15 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             for j in range(n):
                 dq = -0.0
                 for i in range(m):
-                    dq += Y[j, i] * sm[i]
+                    dq = fma(Y[j, i], sm[i], dq)
                 dv = -0.0
                 for i in range(r):
-                    dv += Y[j, i] * mu[i]
-                xdot[j] -= gam * dq
-                xdot[n + j] -= gam * dv
-        if bad_mass:
-            return _MASS_NOT_SPD
-        if bad_S:
-            return _SINGULAR_S
-        return _OK
+                    dv = fma(Y[j, i], mu[i], dv)
+                xdot[j] = fma(-gam, dq, xdot[j])
+                xdot[n + j] = fma(-gam, dv, xdot[n + j])
+        # the mass matrix's failure first (MASS_NOT_SPD > SINGULAR_S > OK = 0); arithmetic,
+        # not branches, which LLVM sank the S test into and then could not vectorize
+        return max(_MASS_NOT_SPD * bad_mass, _SINGULAR_S * bad_S)
 
     @njit(error_model="numpy")
     def project(t, x, p, ws, sweeps, tol):
@@ -378,7 +375,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 for j in range(n):
                     s = -0.0
                     for i in range(cols):
-                        s += Y[j, i] * rhs_[i]
+                        s = fma(Y[j, i], rhs_[i], s)
                     x[level * n + j] -= s
         return _OK
 

@@ -14,20 +14,29 @@ Every function of the step is compiled once and marked ``alwaysinline`` for LLVM
 numba re-types the whole caller for each IR-inlined call site, which made the compile time
 grow with the number of stages (RK4 on the pendulum: 24 s against 3.8 s now), while LLVM
 inlines the compiled bodies in a fraction of that.  With no calls, no heap arrays and no
-early exits left in the loop body, and every array the loop touches an alloca that no
-other pointer reaches (the parameters, the law's numbers and the tableau are copied to the
-stack first), LLVM keeps the buffers in registers and vectorizes the member loop without
-run-time alias checks.
+branches left in the loop body (the pivot tests of L D Lᵀ and the step's status are
+arithmetic: a chain of branches on them kept LLVM from vectorizing), and every array the
+loop touches an alloca that no other pointer reaches (the parameters, the law's numbers
+and the tableau are copied to the stack first), LLVM keeps the buffers in registers and
+vectorizes the member loop without run-time alias checks.
 
-Members never interact, so results are bit-for-bit the same for any thread count and any
-block size, and identical to :func:`stabdae.integrate` for the same initial state (the same
-operations in the same order: zero coefficients skipped in both, sums started from −0.0,
-``1 · k`` is ``k``).  A step reads one state buffer and writes the other, so the hot loop
-needs no masked store: a member whose step fails (singular ``S``, mass not SPD, non-finite
-state) or whose residual exceeds the divergence threshold at a stored sample keeps its
-last good state as its final state and is flagged, and its slot goes on with a copy of a
-running member (numbers nobody reads) so that it does not fail again at every step; the
-other members are untouched.
+The library's own multiply-adds are fused (:mod:`._fma`) at the same places as in
+:func:`stabdae.integrate`'s step.  Members never interact, so results are bit-for-bit the
+same for any thread count and any block size, and identical to :func:`stabdae.integrate`
+for the same initial state (the same operations in the same order: zero coefficients
+skipped in both, sums started from −0.0, ``1 · k`` is ``k``).
+
+The block is updated in place: the step of member ``j`` reads and writes column ``j``
+only, which LLVM sees without run-time alias checks.  (With two buffers swapped every
+step it could not tell them apart and wanted a check per pair of rows, and for more than
+a few state components it gave up vectorizing: the double pendulum's loop ran scalar.)
+A member whose step fails (singular ``S``, mass not SPD, non-finite state) has then
+overwritten its last good state; the kernel keeps a copy of the block at most
+``CHECKPOINT`` steps old and recomputes that state from it with the same step
+(:func:`replay`, bit for bit).  The member keeps it as its final state and is flagged,
+as is one whose residual exceeds the divergence threshold at a stored sample (it keeps
+that sample's state); its slot goes on with a copy of a running member (numbers nobody
+reads) so that it does not fail again at every step; the other members are untouched.
 """
 
 from __future__ import annotations
@@ -40,9 +49,12 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from ._cache import kernel_key, keyed_cache, tag
+from ._fma import fma
 from ._status import Status
 
 BLOCK = 64
+#: the ensemble kernel keeps a copy of the block at most this many steps old (see ``replay``)
+CHECKPOINT = 32
 _NONFINITE = int(Status.NONFINITE_STATE)
 _DIVERGED = int(Status.DIVERGED)
 
@@ -144,28 +156,39 @@ def _member_step_source(pattern) -> str:
     a_kind, b_kind = pattern
     stages = len(b_kind)
 
-    def a_term(s, q):  # (τ a_sq) k_q, as the loop of ``step`` computes it; τ · 1 is τ
-        return f"tau * k{q}[l]" if a_kind[s][q] == 1 else f"(tau * tab_a[{s}, {q}]) * k{q}[l]"
+    def stage_arg(s):  # x + Σ (τ a_sq) k_q, fused, in the order of ``step``; τ · 1 is τ
+        e = "xk[l]"
+        for q in range(s):
+            if a_kind[s][q]:
+                c = "tau" if a_kind[s][q] == 1 else f"(tau * tab_a[{s}, {q}])"
+                e = f"fma({c}, k{q}[l], {e})"
+        return e
 
-    def b_term(s):  # b_s k_s; 1 · k is k
-        return f"k{s}[l]" if b_kind[s] == 1 else f"tab_b[{s}] * k{s}[l]"
+    def weights():  # Σ b_s k_s from −0.0 as ``step`` sums it: b k + (−0) is b k, 1 · k is k
+        e = None
+        for s in range(stages):
+            if not b_kind[s]:
+                continue
+            if e is None:
+                e = f"k{s}[l]" if b_kind[s] == 1 else f"tab_b[{s}] * k{s}[l]"
+            else:
+                e = f"({e} + k{s}[l])" if b_kind[s] == 1 else f"fma(tab_b[{s}], k{s}[l], {e})"
+        return e or "-0.0"
 
     lines = ["def member_step(t, xk, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, xs, xn):"]
     lines += [f"    k{s} = stack1(N2)" for s in range(stages)]
     for s in range(stages):
-        terms = [a_term(s, q) for q in range(s) if a_kind[s][q]]
         arg = "xk"
-        if terms:
-            lines += ["    for l in range(N2):", f"        xs[l] = xk[l] + {' + '.join(terms)}"]
+        if any(a_kind[s][:s]):
+            lines += ["    for l in range(N2):", f"        xs[l] = {stage_arg(s)}"]
             arg = "xs"
         lines.append(
             f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg}, p, law_mat, law_scal, ws, k{s})"
         )
-    comb = " + ".join(b_term(s) for s in range(stages) if b_kind[s]) or "-0.0"
     lines += [
         "    finite = True",
         "    for l in range(N2):",
-        f"        xn[l] = xk[l] + tau * ({comb})",
+        f"        xn[l] = fma(tau, {weights()}, xk[l])",
         "        finite &= math.isfinite(xn[l])",
         "    c = " + ("max(" + ", ".join(f"c{s}" for s in range(stages)) + ")"
                      if stages > 1 else "c0"),
@@ -175,7 +198,7 @@ def _member_step_source(pattern) -> str:
 
 
 def _member_step(rhs, N2: int, pattern):
-    namespace = {"rhs": rhs, "stack1": stack1, "N2": N2, "math": math,
+    namespace = {"rhs": rhs, "stack1": stack1, "N2": N2, "math": math, "fma": fma,
                  "_NONFINITE": _NONFINITE}  # fmt: skip
     exec(compile(_member_step_source(pattern), f"<stabdae step {pattern}>", "exec"), namespace)
     return njit(forceinline=True, error_model="numpy")(namespace["member_step"])
@@ -219,20 +242,37 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         return nrm
 
     @njit(error_model="numpy")
-    def retire(X_old, X_new, j, row, active, code, x_final):
+    def retire(X, j, row, active, code, x_final, x_last):
         """Stop slot ``j``.  Its member, output ``row`` (``-1``: padding, or a slot that
-        was already stopped), keeps ``X_old[:, j]`` as its final state; the slot then takes
-        the ``X_new`` state of a running member whose last step succeeded, so that it
-        computes harmless numbers from now on instead of failing at every step."""
+        was already stopped), gets ``x_last`` as its final state; the slot then takes the
+        state of a running member whose last step succeeded, so that it computes harmless
+        numbers from now on instead of failing at every step."""
         if row >= 0:
             for l in range(N2):
-                x_final[row, l] = X_old[l, j]
+                x_final[row, l] = x_last[l]
         active[j] = False
         for src in range(active.shape[0]):
             if active[src] and code[src] == 0:
                 for l in range(N2):
-                    X_new[l, j] = X_new[l, src]
+                    X[l, j] = X[l, src]
                 break
+
+    @njit(error_model="numpy")
+    def replay(Xc, j, s0, s1, t0, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, x_out):
+        """The state of slot ``j`` after step ``s1``, recomputed from the checkpoint ``Xc``
+        (its state after step ``s0``) with the kernel's own step, so bit for bit what the
+        vectorized loop computed.  Runs when a member's step fails, to recover the last
+        good state that the in-place update overwrote."""
+        ws = stack_workspace()
+        xs = stack1(N2)
+        xn = stack1(N2)
+        for l in range(N2):
+            x_out[l] = Xc[l, j]
+        for i in range(s0 + 1, s1 + 1):
+            member_step(t0 + (i - 1) * tau, x_out, tau, p, law_mat, law_scal, tab_a, tab_b,
+                        tab_c, ws, xs, xn)  # fmt: skip
+            for l in range(N2):
+                x_out[l] = xn[l]
 
     @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a, tab_b, tab_c,
@@ -261,10 +301,12 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             tc[i] = tab_c[i]
             for j in range(S_):
                 ta[i, j] = tab_a[i, j]
-        # The block: two state buffers (a step reads Xa and writes Xb, so a failed step
-        # leaves the member's last good state in Xa) and the status of each slot's step.
-        Xa = stack2(N2, B)
-        Xb = stack2(N2, B)
+        # The block, updated in place (member j's step reads and writes column j only, so
+        # the loop needs no run-time alias checks); a checkpoint of it at most CHECKPOINT
+        # steps old, from which a member whose step fails is replayed to its last good
+        # state; and the status of each slot's step.
+        X = stack2(N2, B)
+        Xc = stack2(N2, B)
         code = stack_int1(B)
         active = np.zeros(B, dtype=np.bool_)  # members (not padding) still running
         ws_h = K_make_workspace()
@@ -278,13 +320,13 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 code[j] = 0
                 active[j] = False
                 for l in range(N2):
-                    Xa[l, j] = x0s[src, l]
+                    X[l, j] = x0s[src, l]
             alive = 0
             for j in range(cnt):
                 for l in range(N2):
-                    xs_h[l] = Xa[l, j]
+                    xs_h[l] = X[l, j]
                 e0[lo + j] = energy(t0, xs_h, p, ws_h)
-                nrm = save_sample(Xa, j, t0, p, ws_h, g, xs_h)
+                nrm = save_sample(X, j, t0, p, ws_h, g, xs_h)
                 out_norm[lo + j, 0] = nrm
                 active[j] = True
                 alive += 1
@@ -295,7 +337,14 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             for j in range(cnt):
                 if code[j] != 0:
                     alive -= 1
-                    retire(Xa, Xa, j, lo + j, active, code, x_final)
+                    for l in range(N2):
+                        xs_h[l] = X[l, j]
+                    retire(X, j, lo + j, active, code, x_final, xs_h)
+            for l in range(N2):
+                for j in range(B):
+                    Xc[l, j] = X[l, j]
+            checkpoint = 0  # the step after which Xc was taken
+            until_save = save_every  # steps to the next stored sample (no division per step)
             for i in range(1, nsteps + 1):
                 if alive == 0:
                     break
@@ -307,10 +356,10 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     xs = stack1(N2)
                     xn = stack1(N2)
                     for l in range(N2):
-                        xk[l] = Xa[l, j]
+                        xk[l] = X[l, j]
                     c = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn)
                     for l in range(N2):
-                        Xb[l, j] = xn[l]
+                        X[l, j] = xn[l]
                     code[j] = c
                     bad |= c != 0
                 if bad:  # rare: record the members whose step failed, recycle their slots
@@ -321,28 +370,37 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                                 status[row] = code[j]
                                 fail_step[row] = i - 1
                                 alive -= 1
-                            retire(Xa, Xb, j, row, active, code, x_final)
-                Xa, Xb = Xb, Xa
-                if i % save_every == 0 and alive > 0:
+                                replay(Xc, j, checkpoint, i - 1, t0, tau, p_s, lm, ls, ta, tb,
+                                       tc, xs_h)  # fmt: skip
+                            retire(X, j, row, active, code, x_final, xs_h)
+                until_save -= 1
+                if until_save == 0 and alive > 0:
                     tn = t0 + i * tau
                     for j in range(cnt):
                         if active[j]:
-                            nrm = save_sample(Xa, j, tn, p, ws_h, g, xs_h)
+                            nrm = save_sample(X, j, tn, p, ws_h, g, xs_h)
                             out_norm[lo + j, i // save_every] = nrm
                             if not (nrm <= threshold):
                                 status[lo + j] = _DIVERGED
                                 fail_step[lo + j] = i
                                 alive -= 1
-                                retire(Xa, Xa, j, lo + j, active, code, x_final)
+                                retire(X, j, lo + j, active, code, x_final, xs_h)
+                if until_save == 0:
+                    until_save = save_every
+                if i - checkpoint == CHECKPOINT:
+                    checkpoint = i
+                    for l in range(N2):
+                        for j in range(B):
+                            Xc[l, j] = X[l, j]
             tf = t0 + nsteps * tau
             for j in range(cnt):
                 if active[j]:
                     for l in range(N2):
-                        x_final[lo + j, l] = Xa[l, j]
+                        x_final[lo + j, l] = X[l, j]
                 for l in range(N2):
                     xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
-    tag(key, stack_workspace, save_sample, retire, member_step)
+    tag(key, stack_workspace, save_sample, retire, replay, member_step)
     return keyed_cache(soa_kernel, key)
