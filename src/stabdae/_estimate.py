@@ -94,16 +94,18 @@ def _fit_linear(env, on_env, times, start, end):
 
 
 @njit(cache=True)
-def _fit_with_log(env, on_env, times, start, end, shift, a, b):
+def _fit_with_log(env, on_env, times, start, end, shift, a, b, lg):
     """Least squares ``env ≈ c − β t + ν log(t + shift)`` on [start, end); returns (β, SSE),
-    SSE = inf when the normal equations are singular."""
+    SSE = inf when the normal equations are singular.  ``lg`` is scratch (the logarithms,
+    taken once for both passes)."""
     a[:, :] = 0.0
     b[:] = 0.0
     for i in range(start, end):
         if not on_env[i]:
             continue
         t = times[i] - times[0]
-        r0, r1, r2 = 1.0, -t, math.log(t + shift)
+        lg[i] = math.log(t + shift)
+        r0, r1, r2 = 1.0, -t, lg[i]
         a[0, 0] += r0 * r0
         a[0, 1] += r0 * r1
         a[0, 2] += r0 * r2
@@ -123,14 +125,15 @@ def _fit_with_log(env, on_env, times, start, end, shift, a, b):
         if not on_env[i]:
             continue
         t = times[i] - times[0]
-        r = env[i] - b[0] + b[1] * t - b[2] * math.log(t + shift)
+        r = env[i] - b[0] + b[1] * t - b[2] * lg[i]
         sse += r * r
     return b[1], sse
 
 
 @njit(cache=True)
-def _fit_one(norm, nvalid, times, env, on_env, tail, out):
-    """Fit one trace; writes (β, γ, floor, transient samples) into ``out``."""
+def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
+    """Fit one trace; writes (β, γ, floor, transient samples) into ``out``.  ``env``,
+    ``on_env``, ``tail``, ``lg`` (samples), ``a`` (3 × 3) and ``b`` (3) are scratch."""
     out[0] = math.nan
     out[1] = math.nan
     out[2] = math.nan
@@ -140,7 +143,8 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, out):
     ntail = min(max(3, nvalid // 5), nvalid)
     for i in range(ntail):
         tail[i] = norm[nvalid - ntail + i]
-    srt = np.sort(tail[:ntail])
+    srt = tail[:ntail]
+    srt.sort()
     floor = srt[ntail // 2] if ntail % 2 == 1 else 0.5 * (srt[ntail // 2 - 1] + srt[ntail // 2])
     out[2] = floor
     # upper envelope of log ‖g‖ from the right: non-increasing, blind to the dips of an
@@ -189,8 +193,6 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, out):
     # plain exponential (ν = 0), then ν log(t + s) over a log-spaced grid of shifts s
     beta, best = _fit_linear(env, on_env, times, start, end)
     if npts >= 6:
-        a = np.empty((3, 3))
-        b = np.empty(3)
         # shifts s = e^u − t_w over (−t_w, ∞), t_w the window's first time: a negative s
         # puts a zero crossing of c0 + c1 t just before the window.  Grid in u, then a
         # golden-section refinement around the best grid point.
@@ -201,7 +203,7 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, out):
         k_best = -1
         for k in range(N_SHIFTS):
             u = lo + k * step_u
-            bk, sse = _fit_with_log(env, on_env, times, start, end, math.exp(u) - t_w, a, b)
+            bk, sse = _fit_with_log(env, on_env, times, start, end, math.exp(u) - t_w, a, b, lg)
             if sse < best:
                 best, beta, k_best = sse, bk, k
         if k_best >= 0:
@@ -210,8 +212,8 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, out):
             for _ in range(GOLDEN_ITERATIONS):
                 u1 = ub - 0.6180339887498949 * (ub - ua)
                 u2 = ua + 0.6180339887498949 * (ub - ua)
-                b1, s1 = _fit_with_log(env, on_env, times, start, end, math.exp(u1) - t_w, a, b)
-                b2, s2 = _fit_with_log(env, on_env, times, start, end, math.exp(u2) - t_w, a, b)
+                b1, s1 = _fit_with_log(env, on_env, times, start, end, math.exp(u1) - t_w, a, b, lg)
+                b2, s2 = _fit_with_log(env, on_env, times, start, end, math.exp(u2) - t_w, a, b, lg)
                 if s1 < best:
                     best, beta = s1, b1
                 if s2 < best:
@@ -240,10 +242,13 @@ def fit_decay_kernel(norms, nvalid, times, out):
         on_env = np.empty(T, dtype=np.bool_)
         tail = np.empty(T)
         row = np.empty(T)
+        lg = np.empty(T)
+        a = np.empty((3, 3))
+        b = np.empty(3)
         for j in range(c * 256, min(M, (c + 1) * 256)):
             for i in range(T):
                 row[i] = norms[j, i]
-            _fit_one(row, nvalid[j], times, env, on_env, tail, out[j])
+            _fit_one(row, nvalid[j], times, env, on_env, tail, lg, a, b, out[j])
 
 
 @njit(parallel=True, cache=True)
