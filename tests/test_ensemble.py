@@ -16,6 +16,7 @@ import xarray as xr
 import stabdae
 from conftest import ROOT, load_scene
 from stabdae._dataset import write_netcdf
+from stabdae._fma import HOST_FMA
 from stabdae._soa import CHECKPOINT
 
 # ω = 1000 with τω = 0.1: the residual decays over several decades before the truncation
@@ -152,6 +153,7 @@ def test_dataset_schema_and_round_trip(tmp_path):
     for key in ("model", "law", "scheme", "tau", "seed", "stabdae_version", "created_at"):
         assert key in ds.attrs, key
     assert ds.attrs["residual_norm_dtype"] == "float32"
+    assert ds.attrs["fused_multiply_add"] == int(HOST_FMA)
     path = write_netcdf(ds, tmp_path / "ens.nc")
     with xr.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), ds)

@@ -42,6 +42,8 @@ from numba.core.caching import (
     _CacheLocator,
 )
 
+from ._fma import HOST_FMA
+
 __all__ = ["cache_dir", "clear", "fingerprint", "function_fingerprint", "kernel_key", "keyed_cache",
            "tag"]
 
@@ -69,8 +71,7 @@ def clear() -> None:
 
 @cache
 def _library_fingerprint() -> str:
-    from ._fma import HOST_FMA  # the library's multiply-adds compile differently without FMA
-
+    # the library's multiply-adds compile differently without FMA (._fma)
     text = f"numba {numba.__version__} py {sys.version_info[:2]} fma {HOST_FMA}"
     h = hashlib.sha256(text.encode())
     for path in sorted(Path(__file__).parent.glob("*.py")):

@@ -16,7 +16,7 @@ around it) when the host CPU has FMA instructions (x86-64 since 2013, every AArc
 CPU without them ``llvm.fma`` would become a call to the C library's software ``fma``,
 several times slower and in the way of vectorization; there ``fma`` is ``a * b + c`` with
 two roundings.  Results then differ from an FMA machine's at the roundoff level, which
-:data:`HOST_FMA` records and the datasets' provenance reports.
+:data:`HOST_FMA` records and every dataset reports (attribute ``fused_multiply_add``).
 """
 
 from __future__ import annotations

@@ -340,14 +340,16 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     for l in range(N2):
                         xs_h[l] = X[l, j]
                     retire(X, j, lo + j, active, code, x_final, xs_h)
-            for l in range(N2):
-                for j in range(B):
-                    Xc[l, j] = X[l, j]
-            checkpoint = 0  # the step after which Xc was taken
+            checkpoint = -CHECKPOINT  # the step after which Xc was taken (none yet)
             until_save = save_every  # steps to the next stored sample (no division per step)
             for i in range(1, nsteps + 1):
                 if alive == 0:
                     break
+                if i - 1 - checkpoint == CHECKPOINT:
+                    checkpoint = i - 1
+                    for l in range(N2):
+                        for j in range(B):
+                            Xc[l, j] = X[l, j]
                 t = t0 + (i - 1) * tau
                 bad = False
                 for j in range(B):  # the whole step of every member
@@ -374,7 +376,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                                        tc, xs_h)  # fmt: skip
                             retire(X, j, row, active, code, x_final, xs_h)
                 until_save -= 1
-                if until_save == 0 and alive > 0:
+                if until_save == 0:  # a stored sample
+                    until_save = save_every
                     tn = t0 + i * tau
                     for j in range(cnt):
                         if active[j]:
@@ -385,13 +388,6 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                                 fail_step[lo + j] = i
                                 alive -= 1
                                 retire(X, j, lo + j, active, code, x_final, xs_h)
-                if until_save == 0:
-                    until_save = save_every
-                if i - checkpoint == CHECKPOINT:
-                    checkpoint = i
-                    for l in range(N2):
-                        for j in range(B):
-                            Xc[l, j] = X[l, j]
             tf = t0 + nsteps * tau
             for j in range(cnt):
                 if active[j]:
