@@ -150,16 +150,18 @@ def test_blow_up_stops_with_a_status_and_keeps_the_finite_part():
 
 def _divisions(model) -> int:
     """Divisions in the compiled RK step, where the rhs is inlined (Euler: once); the
-    L D Lᵀ factorizations divide once per pivot and nothing else in the rhs divides."""
+    L D Lᵀ factorizations divide once per pivot and nothing else in the rhs divides.
+    The caller switches the kernel cache off: a kernel loaded from disk brings no LLVM IR."""
     stabdae.integrate(model, None, stabdae.baumgarte(10.0), "euler", 0.1, 0.1)  # compile
     step = stepper_for(model, bind_law(stabdae.baumgarte(10.0), model)).step
     ir = next(iter(step.inspect_llvm().values()))
     return len(re.findall(r"= fdiv (?:[a-z]+ )*double ", ir))
 
 
-def test_identity_mass_compiles_no_factorization():
+def test_identity_mass_compiles_no_factorization(monkeypatch):
     """One division (the 1×1 pivot of S) without a mass matrix; with an explicit 2×2
     identity the mass factorization adds two."""
+    monkeypatch.setenv("STABDAE_CACHE_DIR", "off")
     plain = unit_pendulum("no_mass")
     explicit = unit_pendulum("with_mass", mass=mass_identity)
     assert _divisions(plain) == 1
