@@ -291,12 +291,13 @@ def ensemble(
     wall_sample = time.perf_counter() - clock
 
     nsave = save_times.shape[0] + 1 if adaptive else nsteps // save_every + 1
-    norms = np.full((M, nsave), np.nan, dtype=rdtype)
+    # the fixed-step kernel writes every element of these (first touch on its threads)
+    norms = np.empty((M, nsave), dtype=rdtype)
     x_final = np.empty_like(x0)
-    run_status = np.zeros(M, dtype=np.int8)
-    fail_step = np.full(M, -1, dtype=np.int64)
-    e0 = np.full(M, np.nan)
-    e1 = np.full(M, np.nan)
+    run_status = np.empty(M, dtype=np.int8)
+    fail_step = np.empty(M, dtype=np.int64)
+    e0 = np.empty(M)
+    e1 = np.empty(M)
     x0c = np.ascontiguousarray(x0)
     extra = None
     clock = time.perf_counter()
@@ -304,6 +305,10 @@ def ensemble(
         steps = np.zeros(M, dtype=np.int64)
         nfev = np.zeros(M, dtype=np.int64)
         kernel = adaptive_ensemble_for(model, bound)
+        norms.fill(np.nan)
+        fail_step.fill(-1)
+        e0.fill(np.nan)
+        e1.fill(np.nan)
         run_status[:] = status  # members that could not be placed stay out
         run_chunks(
             lambda lo, hi: kernel(

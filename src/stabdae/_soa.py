@@ -279,9 +279,13 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                    threshold, out_norm, x_final, status, fail_step, e0, e1,
                    b_lo, b_hi):  # fmt: skip
         """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
-        :func:`stabdae.ensemble`.  ``out_norm`` must be pre-filled (NaN): samples after a
-        stop are not written.  Releases the GIL (run by :func:`._threads.run_chunks`)."""
+        :func:`stabdae.ensemble`.  Every output row of the blocks is written here
+        (``out_norm`` NaN after a stop, ``status`` 0 and ``fail_step`` −1 for a member
+        that runs to the end), so the driver allocates them empty and the pages of the
+        large ``out_norm`` are first touched by the threads that fill them.  Releases the
+        GIL (run by :func:`._threads.run_chunks`)."""
         M = x0s.shape[0]
+        nsave = out_norm.shape[1]
         # The small run-time inputs copied to the stack, so that the loops read memory no
         # store of theirs can touch (loads hoisted, no run-time alias checks).
         p_s = stack1(NP)
@@ -321,6 +325,11 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 active[j] = False
                 for l in range(N2):
                     X[l, j] = x0s[src, l]
+            for j in range(cnt):
+                status[lo + j] = 0
+                fail_step[lo + j] = -1
+                for s in range(nsave):
+                    out_norm[lo + j, s] = math.nan
             alive = 0
             for j in range(cnt):
                 for l in range(N2):
