@@ -12,6 +12,7 @@ import warnings
 import numpy as np
 import pytest
 import xarray as xr
+from numba import njit
 
 import stabdae
 from conftest import ROOT, load_scene
@@ -277,7 +278,7 @@ def test_members_stopped_mid_run_keep_their_last_good_state():
         assert (ds.status.values == status).all(), status
         steps = ds.diverged_step.values
         assert len(set(steps.tolist())) > 1 and (steps > 0).all()
-        if status == stabdae.Status.NONFINITE_STATE:  # the last good state was replayed
+        if status == stabdae.Status.NONFINITE_STATE:  # the block was rolled back
             assert ((steps > CHECKPOINT) & (steps % CHECKPOINT > 1)).any(), steps
         for j in range(5):
             span = steps[j] * tau
@@ -341,3 +342,32 @@ def test_fitted_rate_of_exact_decays(c0):
     bound = gamma[:, None] * np.exp(-got[:, None] * t)
     for j in range(3):
         assert np.all(traces[j, : n[j]] <= bound[j, : n[j]] * (1 + 1e-12))
+
+
+@njit
+def _mass_swing(t, q, p, out):
+    """SPD only while q0 > −1/2: the members below stop when their swing gets there."""
+    out[0, 0] = 1.0
+    out[0, 1] = 0.0
+    out[1, 0] = 0.0
+    out[1, 1] = q[0] + 0.5
+
+
+def test_members_stopped_by_a_status_keep_their_last_good_state():
+    """A step that fails with a status (mass not SPD) leaves finite numbers, which the
+    block's check after 32 steps or at a sample still sees: each member stops at its own
+    step, keeps the state before it and reports the status, as ``integrate`` does."""
+    from toy import unit_pendulum
+
+    model = unit_pendulum("swing_mass", mass=_mass_swing)
+    x0 = np.array([[0.0, -1.0, -v, 0.0] for v in (2.0, 2.5, 3.0, 3.5, 4.0)])
+    law = stabdae.baumgarte(10.0)
+    ds = stabdae.ensemble(model, law, "rk4", 1e-3, 1.0, x0=x0, save_dt=0.1)
+    steps = ds.diverged_step.values
+    assert (ds.status.values == stabdae.Status.MASS_NOT_SPD).all()
+    assert len(set(steps.tolist())) == 5 and (steps % CHECKPOINT > 1).any(), steps
+    for j in range(5):
+        with pytest.warns(stabdae.IntegrationWarning, match="not symmetric positive"):
+            one = stabdae.integrate(model, x0[j], law, "rk4", 1e-3, 1.0, 1e-3)
+        assert one.attrs["steps_completed"] == steps[j]
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[steps[j]])

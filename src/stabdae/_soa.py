@@ -30,13 +30,21 @@ The block is updated in place: the step of member ``j`` reads and writes column 
 only, which LLVM sees without run-time alias checks.  (With two buffers swapped every
 step it could not tell them apart and wanted a check per pair of rows, and for more than
 a few state components it gave up vectorizing: the double pendulum's loop ran scalar.)
-A member whose step fails (singular ``S``, mass not SPD, non-finite state) has then
-overwritten its last good state; the kernel keeps a copy of the block at most
-``CHECKPOINT`` steps old and recomputes that state from it with the same step
-(:func:`replay`, bit for bit).  The member keeps it as its final state and is flagged,
-as is one whose residual exceeds the divergence threshold at a stored sample (it keeps
-that sample's state); its slot goes on with a copy of a running member (numbers nobody
-reads) so that it does not fail again at every step; the other members are untouched.
+Failures are looked for at checks, not after every step: the loop's step only ORs its
+right-hand sides' status into the slot's ``code``.  A check (:func:`block_failed`: a
+status, or a non-finite state, which stays non-finite once it is) comes at every stored
+sample, every ``CHECKPOINT`` steps and at the end; a block that passes is copied to
+``Xc``.  A block that fails is rolled back to that copy and stepped again up to the
+check, now one step at a time with a check and a copy after each: the members whose
+step fails (singular ``S``, mass not SPD, non-finite state) are stopped with the state
+before it, which the in-place update had overwritten; the others recompute the same
+numbers.  Each rollback stops at least one member, so a block rolls back at most once
+per member.  (Testing every step and reducing the test over the block cost about a tenth
+of the loop; a scalar replay of the failed member instead compiled a second copy of the
+step.)  A member is also stopped when its residual exceeds the divergence threshold at
+a stored sample (it keeps that sample's state).  A stopped member's slot goes on with a
+copy of a running member (numbers nobody reads) so that it does not fail again at every
+step; the other members are untouched.
 """
 
 from __future__ import annotations
@@ -53,7 +61,7 @@ from ._fma import fma
 from ._status import Status
 
 BLOCK = 64
-#: the ensemble kernel keeps a copy of the block at most this many steps old (see ``replay``)
+#: the ensemble kernel checks the block at least this often (steps) and keeps a copy of it
 CHECKPOINT = 32
 _NONFINITE = int(Status.NONFINITE_STATE)
 _DIVERGED = int(Status.DIVERGED)
@@ -146,6 +154,8 @@ def tableau_pattern(scheme) -> tuple:
 def _member_step_source(pattern) -> str:
     """Python source of one member's explicit Runge–Kutta step with the stages written
     out, the zero terms of ``pattern`` left out and the factors equal to one dropped.
+    It returns the worst status of its right-hand sides; the new state's finiteness is
+    left to the kernel's checks (a non-finite state stays non-finite).
 
     Written out rather than looped, so that the body has no inner loops left around the
     inlined right-hand sides and the member loop around it vectorizes for any number of
@@ -186,20 +196,16 @@ def _member_step_source(pattern) -> str:
             f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg}, p, law_mat, law_scal, ws, k{s})"
         )
     lines += [
-        "    finite = True",
         "    for l in range(N2):",
         f"        xn[l] = fma(tau, {weights()}, xk[l])",
-        "        finite &= math.isfinite(xn[l])",
-        "    c = " + ("max(" + ", ".join(f"c{s}" for s in range(stages)) + ")"
-                     if stages > 1 else "c0"),
-        "    return _NONFINITE if (c == 0 and not finite) else c",
+        "    return " + ("max(" + ", ".join(f"c{s}" for s in range(stages)) + ")"
+                        if stages > 1 else "c0"),
     ]  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
 def _member_step(rhs, N2: int, pattern):
-    namespace = {"rhs": rhs, "stack1": stack1, "N2": N2, "math": math, "fma": fma,
-                 "_NONFINITE": _NONFINITE}  # fmt: skip
+    namespace = {"rhs": rhs, "stack1": stack1, "N2": N2, "fma": fma}
     exec(compile(_member_step_source(pattern), f"<stabdae step {pattern}>", "exec"), namespace)
     return njit(forceinline=True, error_model="numpy")(namespace["member_step"])
 
@@ -258,21 +264,15 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 break
 
     @njit(error_model="numpy")
-    def replay(Xc, j, s0, s1, t0, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, x_out):
-        """The state of slot ``j`` after step ``s1``, recomputed from the checkpoint ``Xc``
-        (its state after step ``s0``) with the kernel's own step, so bit for bit what the
-        vectorized loop computed.  Runs when a member's step fails, to recover the last
-        good state that the in-place update overwrote."""
-        ws = stack_workspace()
-        xs = stack1(N2)
-        xn = stack1(N2)
-        for l in range(N2):
-            x_out[l] = Xc[l, j]
-        for i in range(s0 + 1, s1 + 1):
-            member_step(t0 + (i - 1) * tau, x_out, tau, p, law_mat, law_scal, tab_a, tab_b,
-                        tab_c, ws, xs, xn)  # fmt: skip
+    def block_failed(X, code):
+        """Whether a slot's steps since the last check failed: a status in ``code`` or a
+        non-finite state (which stays non-finite once it is)."""
+        bad = False
+        for j in range(code.shape[0]):
+            bad |= code[j] != 0
             for l in range(N2):
-                x_out[l] = xn[l]
+                bad |= not math.isfinite(X[l, j])
+        return bad
 
     @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a, tab_b, tab_c,
@@ -306,9 +306,9 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             for j in range(S_):
                 ta[i, j] = tab_a[i, j]
         # The block, updated in place (member j's step reads and writes column j only, so
-        # the loop needs no run-time alias checks); a checkpoint of it at most CHECKPOINT
-        # steps old, from which a member whose step fails is replayed to its last good
-        # state; and the status of each slot's step.
+        # the loop needs no run-time alias checks); its copy at the last check that it
+        # passed (at most CHECKPOINT steps old), to roll back to; the status of each
+        # slot's steps since then.
         X = stack2(N2, B)
         Xc = stack2(N2, B)
         code = stack_int1(B)
@@ -349,18 +349,18 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     for l in range(N2):
                         xs_h[l] = X[l, j]
                     retire(X, j, lo + j, active, code, x_final, xs_h)
-            checkpoint = -CHECKPOINT  # the step after which Xc was taken (none yet)
+            checkpoint = 0  # the step after which Xc was taken
+            for l in range(N2):
+                for j in range(B):
+                    Xc[l, j] = X[l, j]
             until_save = save_every  # steps to the next stored sample (no division per step)
-            for i in range(1, nsteps + 1):
+            saved_until = until_save  # its value at the checkpoint
+            careful_to = 0  # steps up to this one are checked one by one (after a rollback)
+            i = 1
+            while i <= nsteps:
                 if alive == 0:
                     break
-                if i - 1 - checkpoint == CHECKPOINT:
-                    checkpoint = i - 1
-                    for l in range(N2):
-                        for j in range(B):
-                            Xc[l, j] = X[l, j]
                 t = t0 + (i - 1) * tau
-                bad = False
                 for j in range(B):  # the whole step of every member
                     ws = stack_workspace()
                     xk = stack1(N2)
@@ -371,9 +371,14 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     c = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn)
                     for l in range(N2):
                         X[l, j] = xn[l]
-                    code[j] = c
-                    bad |= c != 0
-                if bad:  # rare: record the members whose step failed, recycle their slots
+                    code[j] |= c
+                until_save -= 1
+                renew = True
+                if i <= careful_to:  # stop the members whose step failed; Xc: the step before
+                    for j in range(B):
+                        for l in range(N2):
+                            if code[j] == 0 and not math.isfinite(X[l, j]):
+                                code[j] = _NONFINITE
                     for j in range(B):
                         if code[j] != 0:
                             row = lo + j if (j < cnt and active[j]) else -1
@@ -381,11 +386,25 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                                 status[row] = code[j]
                                 fail_step[row] = i - 1
                                 alive -= 1
-                                replay(Xc, j, checkpoint, i - 1, t0, tau, p_s, lm, ls, ta, tb,
-                                       tc, xs_h)  # fmt: skip
+                            for l in range(N2):
+                                xs_h[l] = Xc[l, j]
                             retire(X, j, row, active, code, x_final, xs_h)
-                until_save -= 1
-                if until_save == 0:  # a stored sample
+                    for j in range(B):
+                        code[j] = 0
+                elif until_save == 0 or i - checkpoint == CHECKPOINT or i == nsteps:
+                    if block_failed(X, code):  # roll back, then step by step up to here
+                        for l in range(N2):
+                            for j in range(B):
+                                X[l, j] = Xc[l, j]
+                        for j in range(B):
+                            code[j] = 0
+                        careful_to = i
+                        until_save = saved_until
+                        i = checkpoint + 1
+                        continue
+                else:
+                    renew = False
+                if until_save == 0:  # a stored sample, of the members whose steps succeeded
                     until_save = save_every
                     tn = t0 + i * tau
                     for j in range(cnt):
@@ -397,6 +416,13 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                                 fail_step[lo + j] = i
                                 alive -= 1
                                 retire(X, j, lo + j, active, code, x_final, xs_h)
+                if renew:  # the block after step i is good: the new checkpoint
+                    checkpoint = i
+                    saved_until = until_save
+                    for l in range(N2):
+                        for j in range(B):
+                            Xc[l, j] = X[l, j]
+                i += 1
             tf = t0 + nsteps * tau
             for j in range(cnt):
                 if active[j]:
@@ -407,5 +433,5 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
-    tag(key, stack_workspace, save_sample, retire, replay, member_step)
+    tag(key, stack_workspace, save_sample, retire, block_failed, member_step)
     return keyed_cache(soa_kernel, key)
