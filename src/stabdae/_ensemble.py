@@ -16,7 +16,7 @@ import xarray as xr
 
 from ._adaptive import adaptive_ensemble_for, save_grid
 from ._dataset import model_coords, provenance, variable
-from ._estimate import fit_decay, trace_summary
+from ._estimate import Summary
 from ._integrate import _positive, _whole_multiple
 from ._laws import as_law, bind_law
 from ._model import Model
@@ -300,6 +300,9 @@ def ensemble(
     e1 = np.empty(M)
     x0c = np.ascontiguousarray(x0)
     extra = None
+    # each chunk's traces are summarized and fitted by the thread that integrated them,
+    # while they are still in its cache
+    summary = Summary(M)
     clock = time.perf_counter()
     if adaptive:
         steps = np.zeros(M, dtype=np.int64)
@@ -310,32 +313,34 @@ def ensemble(
         e0.fill(np.nan)
         e1.fill(np.nan)
         run_status[:] = status  # members that could not be placed stay out
-        run_chunks(
-            lambda lo, hi: kernel(
-                x0c, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
-                dopri5_embedded_weights(), scheme.c, rtol, atol, tau, 10_000_000,
-                divergence, norms, x_final, run_status, fail_step, e0, e1, steps, nfev,
-                lo, hi,
-            ),
-            M, threads=threads, progress=progress,
-        )  # fmt: skip
         times = np.concatenate([[t0], save_times])
+
+        def chunk(lo, hi):
+            kernel(x0c, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
+                   dopri5_embedded_weights(), scheme.c, rtol, atol, tau, 10_000_000,
+                   divergence, norms, x_final, run_status, fail_step, e0, e1, steps, nfev,
+                   lo, hi)  # fmt: skip
+            summary.rows(norms, times, lo, hi)
+
+        run_chunks(chunk, M, threads=threads, progress=progress)
         extra = {"steps_accepted": steps, "rhs_evaluations": nfev}
         run = dict(method="dopri5-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
                    t_end=float(t_end), save_dt=save_dt)  # fmt: skip
     else:
         kernel = ensemble_kernel_for(model, bound, scheme, block)
+        times = t0 + tau * save_every * np.arange(nsave)
+
+        def chunk(lo, hi):
+            kernel(x0c, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,
+                   scheme.b, scheme.c, divergence, norms, x_final, run_status, fail_step, e0,
+                   e1, lo, hi)  # fmt: skip
+            summary.rows(norms, times, min(lo * block, M), min(hi * block, M))
+
         run_chunks(
-            lambda lo, hi: kernel(
-                x0c, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,
-                scheme.b, scheme.c, divergence, norms, x_final, run_status, fail_step, e0,
-                e1, lo, hi,
-            ),
-            -(-M // block), threads=threads,
+            chunk, -(-M // block), threads=threads,
             progress=None if progress is None
             else lambda done, _: progress(min(M, done * block), M),
         )  # fmt: skip
-        times = t0 + tau * save_every * np.arange(nsave)
         run = dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every,
                    steps=nsteps)  # fmt: skip
     wall_integrate = time.perf_counter() - clock
@@ -343,7 +348,7 @@ def ensemble(
     clock = time.perf_counter()
     ds = _ensemble_dataset(
         model, p, law, scheme, bound, times, x0, alpha0, norms, x_final, status, fail_step,
-        e0, e1, epsilon,
+        e0, e1, epsilon, summary,
         dict(**run, members=M, seed=seed, radius_low=low, radius_high=high, epsilon=epsilon,
              divergence=divergence, sampling_rtol=SAMPLING_RTOL,
              threads=threads if threads is not None else default_threads()),
@@ -351,15 +356,15 @@ def ensemble(
     )  # fmt: skip
     # wall times (compilation included on a first call) for benchmarks; not part of the data
     ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
-                    wall_fit_s=time.perf_counter() - clock)  # fmt: skip
+                    wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
     return ds
 
 
 def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_final,
-                      status, fail_step, e0, e1, epsilon, run, extra=None):  # fmt: skip
+                      status, fail_step, e0, e1, epsilon, summary, run, extra=None):  # fmt: skip
     ok = status == 0
-    nvalid, max_res, final = trace_summary(norms)
-    beta, gamma, floor, _ = fit_decay(norms, times, nvalid)
+    max_res, final = summary.largest, summary.last
+    beta, gamma, floor = summary.beta, summary.gamma, summary.floor
     alpha_norm = np.max(np.abs(alpha0), axis=1)
     floor_ref = float(np.nanmedian(np.where(ok, floor, np.nan))) if ok.any() else np.nan
     decayed = ok & (final <= np.maximum(alpha_norm, DECAYED_FLOOR_FACTOR * floor_ref))

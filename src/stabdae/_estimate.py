@@ -35,7 +35,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
+
+from ._threads import run_chunks
 
 FLOOR_MARGIN = 30.0
 MIN_SAMPLES = 4
@@ -331,30 +333,22 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
     out[1] = gamma
 
 
-@njit(parallel=True, cache=True)
-def fit_decay_kernel(norms, nvalid, times, out):
-    """Fit every row of ``norms`` (members × samples); ``out`` is (members, 4):
-    β, γ, floor, number of transient samples."""
-    M, T = norms.shape
-    nchunks = (M + 255) // 256
-    for c in prange(nchunks):
-        env = np.empty(T)
-        on_env = np.empty(T, dtype=np.bool_)
-        tail = np.empty(T)
-        row = np.empty(T)
-        lg = np.empty(T)
-        a = np.empty((3, 3))
-        b = np.empty(3)
-        for j in range(c * 256, min(M, (c + 1) * 256)):
-            for i in range(T):
-                row[i] = norms[j, i]
-            _fit_one(row, nvalid[j], times, env, on_env, tail, lg, a, b, out[j])
-
-
-@njit(parallel=True, cache=True)
-def _trace_summary_kernel(norms, nvalid, largest, last):
-    M, T = norms.shape
-    for j in prange(M):
+@njit(nogil=True, cache=True)
+def summarize_rows(norms, times, r0, r1, nvalid, largest, last, fit, do_fit):
+    """Rows ``r0 … r1 − 1`` of the stored traces ``norms`` (members × samples): the
+    number of leading finite samples, the largest finite sample (NaN when the first is
+    not finite), the last of the leading finite ones, and with ``do_fit`` the decay fit
+    into ``fit[j]`` (β, γ, floor, transient samples).  One thread; the ensemble runs it
+    on each chunk of members right after integrating it (:mod:`._threads`)."""
+    T = norms.shape[1]
+    row = np.empty(T)
+    env = np.empty(T)
+    on_env = np.empty(T, dtype=np.bool_)
+    tail = np.empty(T)
+    lg = np.empty(T)
+    a = np.empty((3, 3))
+    b = np.empty(3)
+    for j in range(r0, r1):
         n = T
         top = -math.inf
         for i in range(T):
@@ -366,6 +360,45 @@ def _trace_summary_kernel(norms, nvalid, largest, last):
         nvalid[j] = n
         largest[j] = top if n > 0 else math.nan
         last[j] = norms[j, max(n - 1, 0)]
+        if do_fit:
+            for i in range(T):
+                row[i] = norms[j, i]
+            _fit_one(row, n, times, env, on_env, tail, lg, a, b, fit[j])
+
+
+class Summary:
+    """Output arrays of :func:`summarize_rows` for ``members`` traces."""
+
+    def __init__(self, members: int):
+        self.nvalid = np.empty(members, dtype=np.int64)
+        self.largest = np.empty(members)
+        self.last = np.empty(members)
+        self.fit = np.empty((members, 4))
+
+    def rows(self, norms, times, r0: int, r1: int, do_fit: bool = True) -> None:
+        """Summarize (and fit) rows ``r0 … r1 − 1``; releases the GIL."""
+        summarize_rows(norms, times, r0, r1, self.nvalid, self.largest, self.last, self.fit,
+                       do_fit)  # fmt: skip
+
+    @property
+    def beta(self):
+        return self.fit[:, 0]
+
+    @property
+    def gamma(self):
+        return self.fit[:, 1]
+
+    @property
+    def floor(self):
+        return self.fit[:, 2]
+
+
+def _summarize(norms, times, do_fit: bool) -> Summary:
+    norms = np.ascontiguousarray(np.atleast_2d(norms))
+    times = np.ascontiguousarray(times, dtype=np.float64)
+    out = Summary(norms.shape[0])
+    run_chunks(lambda lo, hi: out.rows(norms, times, lo, hi, do_fit), norms.shape[0])
+    return out
 
 
 def trace_summary(norms):
@@ -375,33 +408,24 @@ def trace_summary(norms):
     The same numbers as ``isfinite`` / ``argmin`` / ``nanmax`` over the whole array, which
     made up most of the time spent after the integration of a large ensemble.
     """
-    norms = np.ascontiguousarray(np.atleast_2d(norms))
-    M = norms.shape[0]
-    nvalid, largest, last = np.empty(M, dtype=np.int64), np.empty(M), np.empty(M)
-    _trace_summary_kernel(norms, nvalid, largest, last)
-    return nvalid, largest, last
+    out = _summarize(norms, np.zeros(1), False)
+    return out.nvalid, out.largest, out.last
 
 
-def fit_decay(norms, times, nvalid=None):
+def fit_decay(norms, times):
     """β, γ, floor and transient length for each trace.
 
     Parameters
     ----------
     norms : array (members, samples)
-        Residual norms ``‖g(t_i)‖`` (float32 or float64); NaN after a divergence.
+        Residual norms ``‖g(t_i)‖`` (float32 or float64); NaN after a divergence (the
+        fit uses the leading finite samples).
     times : array (samples,)
         Uniformly spaced sample times.
-    nvalid : array (members,), optional
-        Number of valid leading samples per member (default: all non-NaN leading ones).
 
     Returns
     -------
     beta, gamma, floor, n_transient : arrays (members,)
     """
-    norms = np.ascontiguousarray(np.atleast_2d(norms))
-    times = np.ascontiguousarray(times, dtype=np.float64)
-    if nvalid is None:
-        nvalid = trace_summary(norms)[0]
-    out = np.empty((norms.shape[0], 4))
-    fit_decay_kernel(norms, np.ascontiguousarray(nvalid, dtype=np.int64), times, out)
-    return out[:, 0], out[:, 1], out[:, 2], out[:, 3].astype(np.int64)
+    fit = _summarize(norms, times, True).fit
+    return fit[:, 0], fit[:, 1], fit[:, 2], fit[:, 3].astype(np.int64)

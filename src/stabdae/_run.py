@@ -28,7 +28,7 @@ from ._study import Study, load_study
 __all__ = ["run_study", "run_point", "combine"]
 
 #: attributes that say when/how fast, not what: left out of the study dataset
-_VOLATILE = ("wall_sample_s", "wall_integrate_s", "wall_fit_s", "created_at", "history",
+_VOLATILE = ("wall_sample_s", "wall_integrate_s", "wall_dataset_s", "created_at", "history",
              "threads")  # fmt: skip
 
 

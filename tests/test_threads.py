@@ -1,0 +1,52 @@
+"""The thread pool that runs compiled kernels over chunks of work items."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import pytest
+
+from stabdae._threads import run_chunks
+
+
+def test_chunks_cover_every_item_once_and_report_progress():
+    seen = []
+    lock = threading.Lock()
+    reports = []
+
+    def kernel(lo, hi):
+        with lock:
+            seen.extend(range(lo, hi))
+
+    run_chunks(kernel, 1000, threads=2, progress=lambda done, n: reports.append((done, n)))
+    assert sorted(seen) == list(range(1000))
+    assert [d for d, _ in reports] == sorted(d for d, _ in reports)
+    assert reports[-1] == (1000, 1000)
+
+
+def test_a_failing_chunk_raises_and_nothing_runs_on_after_the_call():
+    """The error reaches the caller; chunks not started are cancelled and those running
+    finish before ``run_chunks`` returns (the pool is kept between calls)."""
+    running = []
+    finished = []
+
+    def kernel(lo, hi):
+        if hi == 0:
+            return
+        running.append(lo)
+        if lo == 0:
+            raise ValueError("chunk 0 failed")
+        time.sleep(0.01)
+        finished.append(lo)
+
+    with pytest.raises(ValueError, match="chunk 0 failed"):
+        run_chunks(kernel, 64, threads=2)
+    after = (len(running), len(finished))
+    time.sleep(0.05)
+    assert (len(running), len(finished)) == after
+    assert len(running) == len(finished) + 1  # every started chunk but the failed one ended
+    # the pool still works
+    out = []
+    run_chunks(lambda lo, hi: out.extend(range(lo, hi)), 10, threads=2)
+    assert sorted(out) == list(range(10))
