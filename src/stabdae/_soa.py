@@ -343,12 +343,18 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     status[lo + j] = _DIVERGED
                     fail_step[lo + j] = 0
                     code[j] = 1  # not a source for the slots retired below
-            for j in range(cnt):
+            for j in range(cnt, B):  # padding repeats member lo: stopped with it
+                code[j] = code[0]
+            for j in range(B):
                 if code[j] != 0:
-                    alive -= 1
-                    for l in range(N2):
-                        xs_h[l] = X[l, j]
-                    retire(X, j, lo + j, active, code, x_final, xs_h)
+                    row = lo + j if j < cnt else -1
+                    if row >= 0:
+                        alive -= 1
+                        for l in range(N2):
+                            xs_h[l] = X[l, j]
+                    retire(X, j, row, active, code, x_final, xs_h)
+            for j in range(B):  # (the first check would take a status left here for a failure)
+                code[j] = 0
             checkpoint = 0  # the step after which Xc was taken
             for l in range(N2):
                 for j in range(B):
