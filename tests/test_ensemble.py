@@ -344,6 +344,19 @@ def test_fitted_rate_of_exact_decays(c0):
         assert np.all(traces[j, : n[j]] <= bound[j, : n[j]] * (1 + 1e-12))
 
 
+@pytest.mark.parametrize("c0", [1.0, 0.1, -0.3])
+def test_refined_shift_gives_the_repeated_eigenvalue_rate(c0):
+    """On ``|c0 + c1 t| e^{−βt}`` with a floor at 1e-13, the ``ν log(t + s)`` fit with its
+    shift refined (Brent's method) recovers β to 0.2 %; the best of the 16 grid shifts
+    alone is off by 0.6–0.9 %."""
+    from stabdae._estimate import fit_decay
+
+    t = np.arange(401) * 0.01
+    floor = 1e-13 * (1.0 + 0.5 * np.random.default_rng(2).random(t.size))
+    trace = np.abs(c0 + 10.0 * t) * np.exp(-10.0 * t) + floor
+    assert abs(fit_decay(trace[None, :], t)[0][0] / 10.0 - 1) < 0.002
+
+
 @njit
 def _mass_swing(t, q, p, out):
     """SPD only while q0 > −1/2: the members below stop when their swing gets there."""
