@@ -37,8 +37,8 @@ def baumgarte_ensemble(name, scheme, xi, **kw):
 @pytest.mark.parametrize("name", ["pendulum", "double_pendulum"])
 def test_beta_matches_discrete_prediction(name, scheme, xi):
     """Median fitted β within 2 % of −ln ρ(R(τÃ))/τ: under-damped (an oscillating
-    residual, 4–7 periods above the floor), critically damped (repeated eigenvalue,
-    Euler's R(τÃ) a Jordan block) and over-damped."""
+    residual, fitted on its peaks), critically damped (repeated eigenvalue, Euler's
+    R(τÃ) a Jordan block) and over-damped."""
     ds = baumgarte_ensemble(name, scheme, xi)
     assert (ds.status == 0).all()
     predicted = float(ds.beta_theory_discrete)

@@ -264,6 +264,33 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 break
 
     @njit(error_model="numpy")
+    def stop_failed(X, X_last, code, active, lo, cnt, step, status, fail_step, x_final,
+                    x_last):  # fmt: skip
+        """Stop every slot with a status in ``code`` or a non-finite state: its member, if
+        still running, gets that status (``NONFINITE_STATE`` for the state), ``step`` as
+        its failing step and its column of ``X_last`` as final state; the slot is then
+        recycled (:func:`retire`).  Clears ``code``; returns the number of members
+        stopped."""
+        for j in range(B):
+            for l in range(N2):
+                if code[j] == 0 and not math.isfinite(X[l, j]):
+                    code[j] = _NONFINITE
+        stopped = 0
+        for j in range(B):
+            if code[j] != 0:
+                row = lo + j if (j < cnt and active[j]) else -1
+                if row >= 0:
+                    status[row] = code[j]
+                    fail_step[row] = step
+                    stopped += 1
+                for l in range(N2):
+                    x_last[l] = X_last[l, j]
+                retire(X, j, row, active, code, x_final, x_last)
+        for j in range(B):
+            code[j] = 0
+        return stopped
+
+    @njit(error_model="numpy")
     def block_failed(X, code):
         """Whether a slot's steps since the last check failed: a status in ``code`` or a
         non-finite state (which stays non-finite once it is)."""
@@ -340,21 +367,11 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 active[j] = True
                 alive += 1
                 if not (nrm <= threshold):
-                    status[lo + j] = _DIVERGED
-                    fail_step[lo + j] = 0
-                    code[j] = 1  # not a source for the slots retired below
+                    code[j] = _DIVERGED
             for j in range(cnt, B):  # padding repeats member lo: stopped with it
                 code[j] = code[0]
-            for j in range(B):
-                if code[j] != 0:
-                    row = lo + j if j < cnt else -1
-                    if row >= 0:
-                        alive -= 1
-                        for l in range(N2):
-                            xs_h[l] = X[l, j]
-                    retire(X, j, row, active, code, x_final, xs_h)
-            for j in range(B):  # (the first check would take a status left here for a failure)
-                code[j] = 0
+            alive -= stop_failed(X, X, code, active, lo, cnt, 0, status, fail_step, x_final,
+                                 xs_h)  # fmt: skip
             checkpoint = 0  # the step after which Xc was taken
             for l in range(N2):
                 for j in range(B):
@@ -381,22 +398,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 until_save -= 1
                 renew = True
                 if i <= careful_to:  # stop the members whose step failed; Xc: the step before
-                    for j in range(B):
-                        for l in range(N2):
-                            if code[j] == 0 and not math.isfinite(X[l, j]):
-                                code[j] = _NONFINITE
-                    for j in range(B):
-                        if code[j] != 0:
-                            row = lo + j if (j < cnt and active[j]) else -1
-                            if row >= 0:
-                                status[row] = code[j]
-                                fail_step[row] = i - 1
-                                alive -= 1
-                            for l in range(N2):
-                                xs_h[l] = Xc[l, j]
-                            retire(X, j, row, active, code, x_final, xs_h)
-                    for j in range(B):
-                        code[j] = 0
+                    alive -= stop_failed(X, Xc, code, active, lo, cnt, i - 1, status,
+                                         fail_step, x_final, xs_h)  # fmt: skip
                 elif until_save == 0 or i - checkpoint == CHECKPOINT or i == nsteps:
                     if block_failed(X, code):  # roll back, then step by step up to here
                         for l in range(N2):
@@ -439,5 +442,5 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
-    tag(key, stack_workspace, save_sample, retire, block_failed, member_step)
+    tag(key, stack_workspace, save_sample, retire, stop_failed, block_failed, member_step)
     return keyed_cache(soa_kernel, key)
