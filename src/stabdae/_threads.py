@@ -25,8 +25,18 @@ def default_threads() -> int:
 
 
 def _chunks(items: int, threads: int, per_thread: int = 8) -> list[tuple[int, int]]:
-    size = max(1, -(-items // (threads * per_thread)))
-    return [(lo, min(items, lo + size)) for lo in range(0, items, size)]
+    """Consecutive ranges covering ``range(items)``: about ``per_thread`` per thread, and
+    towards the end smaller ones (each at most 1/(2·threads) of what is left, down to one
+    item), so that the threads run out of work at nearly the same time.  With equal
+    chunks the last one kept one thread busy alone: a tenth of a chunk's time per thread
+    on average, 2 % of a 10⁴-member ensemble on two threads."""
+    cap = max(1, -(-items // (threads * per_thread)))
+    out, lo = [], 0
+    while lo < items:
+        size = min(cap, max(1, (items - lo) // (2 * threads))) if threads > 1 else cap
+        out.append((lo, min(items, lo + size)))
+        lo += size
+    return out
 
 
 def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None) -> None:
