@@ -286,16 +286,25 @@ def test_members_stopped_mid_run_keep_their_last_good_state():
             np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
 
 
-def test_trace_summary_matches_numpy():
-    """The one-pass summary of the stored traces gives NumPy's numbers: leading finite
-    samples, largest finite sample, last leading finite one (stops, inf, NaN rows)."""
-    from stabdae._estimate import trace_summary
+@pytest.mark.parametrize("with_fit", [False, True])
+def test_trace_summary_matches_numpy(with_fit):
+    """The summary of the stored traces gives NumPy's numbers: leading finite samples,
+    largest finite sample, last leading finite one (stops, inf, NaN rows).  With the fit
+    (as the ensemble runs it) the largest sample of a finite trace comes from the fit's
+    envelope instead of a pass of its own."""
+    from stabdae._estimate import Summary
+
+    def trace_summary(norms):
+        out = Summary(norms.shape[0])
+        out.rows(norms, np.linspace(0.0, 1.0, norms.shape[1]), 0, norms.shape[0], with_fit)
+        return out.nvalid, out.largest, out.last
 
     norms = np.random.default_rng(0).random((40, 30)).astype(np.float32)
     norms[3, 10:] = np.nan
     norms[4, :] = np.nan
     norms[5, 7], norms[5, 8:] = np.inf, np.nan
     norms[6, 0] = np.nan
+    norms[7, 5], norms[7, 20] = np.nan, 2.0  # the largest finite sample after a NaN
     finite = np.isfinite(norms)
     nvalid = np.where(finite.all(axis=1), norms.shape[1], np.argmin(finite, axis=1))
     largest = np.where(nvalid > 0, np.nanmax(np.where(finite, norms, -np.inf), axis=1), np.nan)
@@ -304,7 +313,8 @@ def test_trace_summary_matches_numpy():
     np.testing.assert_array_equal(got[0], nvalid)
     np.testing.assert_array_equal(got[1], largest)
     np.testing.assert_array_equal(got[2], last)
-    assert got[0][[3, 4, 5, 6]].tolist() == [10, 0, 7, 0]
+    assert got[0][[3, 4, 5, 6, 7]].tolist() == [10, 0, 7, 0, 5]
+    assert got[1][7] == 2.0
 
 
 def test_floor_median_matches_numpy():

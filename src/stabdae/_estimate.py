@@ -284,13 +284,14 @@ def _brent(env, on_env, times, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg)
 @njit(cache=True)
 def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
     """Fit one trace; writes (β, γ, floor, transient samples) into ``out``.  ``env``,
-    ``on_env``, ``tail``, ``lg`` (samples), ``a`` (3 × 3) and ``b`` (3) are scratch."""
+    ``on_env``, ``tail``, ``lg`` (samples), ``a`` (3 × 3) and ``b`` (3) are scratch.
+    Returns the largest of ``norm[:nvalid]`` (−inf when ``nvalid`` is 0)."""
     out[0] = math.nan
     out[1] = math.nan
     out[2] = math.nan
     out[3] = 0.0
     if nvalid < 2:
-        return
+        return norm[0] if nvalid == 1 else -math.inf
     ntail = min(max(3, nvalid // 5), nvalid)
     for i in range(ntail):
         tail[i] = norm[nvalid - ntail + i]
@@ -298,12 +299,13 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
     out[2] = floor
     # upper envelope of ‖g‖ from the right: non-increasing, blind to the dips of an
     # oscillating residual; its logarithm is taken below, on the transient only
-    top = -1.0  # the largest sample so far (norms are >= 0)
+    top = -math.inf  # the largest sample so far
     for i in range(nvalid - 1, -1, -1):
         y = norm[i]
         on_env[i] = y >= top  # a "record" from the right: on the upper hull of the trace
         top = max(top, y)
         env[i] = top
+    largest = top
     # transient: until the envelope comes within a margin of the floor.  The floor is a
     # forced response, not noise, and bends the trace well above it: take the widest
     # margin (1000, 100, then FLOOR_MARGIN) that still leaves 8 samples, or for an
@@ -325,7 +327,7 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
     for i in range(end):  # the fits work on log ‖g‖
         env[i] = math.log(env[i]) if env[i] > 0.0 else -math.inf
     if end < MIN_SAMPLES or not math.isfinite(env[end - 1]):
-        return
+        return largest
     # fit window: the later part of the transient, after LEAD_FRACTION of its decades,
     # where faster modes have died out and the decay runs at the asymptotic rate
     cut = env[0] - LEAD_FRACTION * (env[0] - env[end - 1])
@@ -341,7 +343,7 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
         start -= 1
         npts += on_env[start]
     if npts < 2:
-        return
+        return largest
     dt = times[1] - times[0]
     span = times[end - 1] - times[0]
     # plain exponential (ν = 0), then ν log(t + s) over a log-spaced grid of shifts s
@@ -372,6 +374,7 @@ def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
             gamma = g
     out[0] = beta
     out[1] = gamma
+    return largest
 
 
 @njit(nogil=True, cache=True)
@@ -390,21 +393,27 @@ def summarize_rows(norms, times, r0, r1, nvalid, largest, last, fit, do_fit):
     a = np.empty((3, 3))
     b = np.empty(3)
     for j in range(r0, r1):
-        n = T
-        top = -math.inf
+        bad = False  # a non-finite sample (one vectorized pass; most traces have none)
         for i in range(T):
             v = norms[j, i]
-            if math.isfinite(v):
-                top = max(top, v)
-            elif n == T:
-                n = i
+            row[i] = v
+            bad |= not math.isfinite(v)
+        n = T
+        top = -math.inf
+        if bad or not do_fit:
+            for i in range(T):
+                v = row[i]
+                if math.isfinite(v):
+                    top = max(top, v)
+                elif n == T:
+                    n = i
+        if do_fit:  # (the fit's envelope gives the largest sample of a finite trace)
+            top_fit = _fit_one(row, n, times, env, on_env, tail, lg, a, b, fit[j])
+            if not bad:
+                top = top_fit
         nvalid[j] = n
         largest[j] = top if n > 0 else math.nan
-        last[j] = norms[j, max(n - 1, 0)]
-        if do_fit:
-            for i in range(T):
-                row[i] = norms[j, i]
-            _fit_one(row, n, times, env, on_env, tail, lg, a, b, fit[j])
+        last[j] = row[max(n - 1, 0)]
 
 
 class Summary:
