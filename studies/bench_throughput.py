@@ -19,8 +19,9 @@ Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored e
 All start from the same sampled initial states; the final states are compared to make
 sure every variant computes the same thing.  OpenMP's workers sleep between parallel
 regions (``OMP_WAIT_POLICY=PASSIVE`` unless set otherwise): by default they spin for a
-while after each C run and took cores from the variant timed next (the API: 0.108 s
-against 0.105 s at 10⁴ members, the C timings the same either way).  The API, the kernel and the two blocked C
+while after each C run and took cores from the variant timed next (the API at 10⁴
+members, two runs each: 0.106 / 0.109 s against 0.104 / 0.104 s; the C timings the same
+either way).  The API, the kernel and the two blocked C
 builds run ``--repeat`` times in turn and each keeps its best time (timings on a shared
 machine vary by 10 % from run to run); the others run once.
 
