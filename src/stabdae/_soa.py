@@ -378,8 +378,9 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     code[j] = _DIVERGED
             for j in range(cnt, B):  # padding repeats member lo: stopped with it
                 code[j] = code[0]
-            alive -= stop_failed(X, X, code, active, lo, cnt, 0, status, fail_step, x_final,
-                                 xs_h)  # fmt: skip
+            # (step 0 as an int64, not a literal: a literal argument compiles a second copy)
+            alive -= stop_failed(X, X, code, active, lo, cnt, np.int64(0), status, fail_step,
+                                 x_final, xs_h)  # fmt: skip
             checkpoint = 0  # the step after which Xc was taken
             for l in range(N2):
                 for j in range(B):
