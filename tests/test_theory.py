@@ -220,3 +220,25 @@ def test_along_path_floor_bounds_the_residual():
         # constant law: every R_k is the same and its max-norm exceeds 1 (m > 0)
         assert np.ptp(out.spectral_radius.values) < 1e-15
         assert (out.norm_max.values > 1.0).all()
+
+
+def test_predictions_memo_gives_the_computed_values_per_tau_and_law():
+    """The ensemble's predictions are memoized by (Ã, tableau, τ): a repeated call returns
+    what a fresh computation gives, a new τ or gain is a new entry, and a caller that
+    edits the returned dict does not change the next one."""
+    model = stabdae.load_model("pendulum")
+    law, scheme = stabdae.baumgarte(10.0, 0.5), stabdae.midpoint()
+    theory._PREDICTIONS.clear()
+    first = theory.predictions(model, law, scheme, 0.05)
+    first["spectral_radius"] = -1.0
+    again = theory.predictions(model, law, scheme, 0.05)
+    fresh = theory._predictions(law.A_tilde(model), scheme, 0.05, False)
+    assert again == fresh and again["spectral_radius"] > 0
+    # R(τÃ) of the midpoint rule for Baumgarte's 2×2 block: the closed form of ρ
+    z = 0.05 * np.linalg.eigvals(baumgarte_At(10.0, 0.5)).astype(complex)
+    assert again["spectral_radius"] == pytest.approx(np.max(np.abs(1 + z + z**2 / 2)), rel=1e-12)
+    other_tau = theory.predictions(model, law, scheme, 0.02)
+    other_law = theory.predictions(model, stabdae.baumgarte(10.0, 1.0), scheme, 0.05)
+    assert other_tau["spectral_radius"] != again["spectral_radius"]
+    assert other_law["spectral_radius"] != again["spectral_radius"]
+    assert len(theory._PREDICTIONS) == 3

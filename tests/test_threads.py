@@ -50,3 +50,24 @@ def test_a_failing_chunk_raises_and_nothing_runs_on_after_the_call():
     out = []
     run_chunks(lambda lo, hi: out.extend(range(lo, hi)), 10, threads=2)
     assert sorted(out) == list(range(10))
+
+
+@pytest.mark.parametrize(
+    "items, threads", [(157, 2), (1563, 2), (1000, 16), (5, 4), (1, 2), (40, 1)]
+)
+def test_chunks_shrink_towards_the_end(items, threads):
+    """Consecutive ranges over every item; none larger than an equal share of
+    ``threads × 8`` chunks, and with more than one thread each at most half a thread's
+    share of what is left (down to one item), so that the last ones are short."""
+    from stabdae._threads import _chunks
+
+    chunks = _chunks(items, threads)
+    assert chunks[0][0] == 0 and chunks[-1][1] == items
+    assert all(a[1] == b[0] for a, b in zip(chunks, chunks[1:]))
+    cap = -(-items // (threads * 8))
+    for lo, hi in chunks:
+        assert 1 <= hi - lo <= cap
+        if threads > 1:
+            assert hi - lo <= max(1, (items - lo) // (2 * threads))
+    if threads > 1 and items > 2 * threads:
+        assert chunks[-1][1] - chunks[-1][0] == 1
