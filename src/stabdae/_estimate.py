@@ -452,8 +452,10 @@ def _summarize(norms, times, do_fit: bool) -> Summary:
 
 
 def trace_summary(norms):
-    """Per trace, in one pass: the number of leading finite samples, the largest finite
-    sample (NaN when the first is not finite) and the last of the leading finite ones.
+    """Per trace, in one compiled call: the number of leading finite samples, the largest
+    finite sample (NaN when the first is not finite) and the last of the leading finite
+    ones.  (Two passes over each row: :func:`summarize_rows` copies it first, for the fit
+    it runs without here.)
 
     The same numbers as ``isfinite`` / ``argmin`` / ``nanmax`` over the whole array, which
     made up most of the time spent after the integration of a large ensemble.
