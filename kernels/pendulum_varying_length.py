@@ -75,6 +75,7 @@ model = stabdae.Model(
     reference_state=reference_state,
     coordinates=["x", "y"],
     coordinate_units="m",
+    constraint_units=["m2"],
     forces=forces,
     f=f,
     f_q=f_q,

@@ -12,7 +12,7 @@ Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored e
   vectorized by gcc), both OpenMP-parallel (``studies/bench_c/pendulum_rk2.c``); the blocked
   form also with ``-ffp-contract=off`` (no fused multiply-adds at all; gcc's default fuses
   wherever it likes, stabdae fuses its own multiply-adds explicitly, not the user's
-  expressions, see ``stabdae._fma``);
+  expressions, see ``stabdae.kernels.fma``);
 * NumPy vectorized over members;
 * JAX ``lax.scan`` + ``vmap`` when jax is installed.
 
@@ -83,11 +83,10 @@ def run_c(fn, x0):
 
 def run_kernel(model, law, x0, divergence):
     """stabdae's ensemble kernel alone, as ``stabdae.ensemble`` calls it."""
-    from stabdae._ensemble import ensemble_kernel_for
     from stabdae._laws import bind_law
     from stabdae._schemes import as_scheme
-    from stabdae._soa import BLOCK
-    from stabdae._threads import run_chunks
+    from stabdae.kernels.ensemble import BLOCK, ensemble_kernel_for
+    from stabdae.kernels.threads import run_chunks
 
     bound, scheme = bind_law(law, model), as_scheme("midpoint")
     kernel = ensemble_kernel_for(model, bound, scheme, BLOCK)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import re
 import sys
 from pathlib import Path
 
@@ -10,6 +11,12 @@ import numpy as np
 import pytest
 
 import stabdae
+from stabdae._schema import udunits_ok
+from stabdae.kernels.jit import JIT
+
+#: tests that look at compiled code (signatures, LLVM IR, NRT allocations): skipped when
+#: the suite runs as Python with NUMBA_DISABLE_JIT=1
+compiled_only = pytest.mark.skipif(not JIT, reason="inspects compiled code; JIT disabled")
 
 ROOT = Path(__file__).resolve().parents[1]
 KERNELS = ROOT / "kernels"
@@ -63,3 +70,27 @@ def load_file(path: Path, name: str):
     sys.modules[name] = module  # dataclasses look their module up while it runs
     spec.loader.exec_module(module)
     return module
+
+
+#: the one timestamp format of created_at and of every history line
+TIMESTAMP = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
+
+
+def assert_schema(ds) -> None:
+    """Every variable and coordinate of ``ds`` has a long name; every numeric one has valid
+    UDUNITS ``units``, or, when its components mix units, ``units_per_component`` naming a
+    coordinate whose entries are valid units; ``created_at`` and each ``history`` line
+    carry one timestamp format."""
+    for name, var in {**ds.data_vars, **ds.coords}.items():
+        assert var.attrs.get("long_name"), name
+        if var.dtype.kind not in "biuf":
+            continue  # labels (component names, unit strings) have no units
+        if "units" in var.attrs:
+            assert udunits_ok(var.attrs["units"]), (name, var.attrs["units"])
+        else:
+            per = var.attrs.get("units_per_component")
+            assert per in ds.coords, (name, "neither units nor units_per_component")
+            assert all(udunits_ok(str(u)) for u in ds[per].values), (name, ds[per].values)
+    assert TIMESTAMP.match(ds.attrs["created_at"]), ds.attrs["created_at"]
+    lines = ds.attrs["history"].split("\n")
+    assert lines and all(TIMESTAMP.match(line.split(": ", 1)[0]) for line in lines), lines

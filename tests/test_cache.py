@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from numba import njit
 
-from stabdae._cache import function_fingerprint
 from stabdae._loading import scene_dir
+from stabdae.kernels.cache import function_fingerprint
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -25,7 +25,8 @@ CHILD = textwrap.dedent(
     import json, sys, time
     import numpy as np
     import stabdae
-    from stabdae._ensemble import ensemble_kernel_for, sampler_for
+    from stabdae.kernels.ensemble import ensemble_kernel_for
+    from stabdae.kernels.sampler import sampler_for
     from stabdae._laws import bind_law
     clock = time.perf_counter()
     model = stabdae.load_model(sys.argv[1])
@@ -92,7 +93,7 @@ def test_closures_are_told_apart_by_what_they_capture():
 
 @pytest.mark.parametrize("value", ["off", "0"])
 def test_cache_can_be_switched_off(monkeypatch, value):
-    from stabdae._cache import cache_dir, keyed_cache
+    from stabdae.kernels.cache import cache_dir, keyed_cache
 
     monkeypatch.setenv("STABDAE_CACHE_DIR", value)
     assert cache_dir() is None

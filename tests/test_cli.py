@@ -8,7 +8,7 @@ import sys
 import xarray as xr
 
 from conftest import KERNELS, ROOT
-from stabdae._cli import main
+from stabdae.study.cli import main
 
 
 def test_check_passes_on_a_scene(capsys):
@@ -41,7 +41,7 @@ def test_integrate_writes_a_dataset(tmp_path, capsys):
 
 def test_bad_input_exits_with_a_message(tmp_path):
     proc = subprocess.run(
-        [sys.executable, "-m", "stabdae._cli", "integrate", "pendulum", "--tau", "0.3",
+        [sys.executable, "-m", "stabdae.study.cli", "integrate", "pendulum", "--tau", "0.3",
          "-o", str(tmp_path / "x.nc")],
         capture_output=True, text=True, cwd=ROOT,
     )  # fmt: skip

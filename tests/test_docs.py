@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from test_run import study_file
 
-from stabdae._run import run_study
-from stabdae._study import load_study
+from stabdae.study.run import run_study
+from stabdae.study.spec import load_study
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 

@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from stabdae._cli import main
-from stabdae._run import run_study
+from conftest import assert_schema
+from stabdae.study.cli import main
+from stabdae.study.run import run_study
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -75,8 +76,8 @@ def test_run_writes_dataset_and_pictures_and_refuses_to_overwrite(tmp_path, caps
     ds = xr.open_dataset(out)
     assert ds.fraction_bounded.dims == ("tau", "omega")
     assert ds.residual_norm.dims == ("tau", "omega", "member", "time")
-    for name, var in ds.variables.items():
-        assert "units" in var.attrs and ("long_name" in var.attrs or name in ds.dims), name
+    assert_schema(ds)
+    assert "stabdae run study.toml: 12 grid points of 64 members" in ds.attrs["history"]
     # τ = 0.1, 0.2 are larger than save_dt: samples between their steps are NaN
     r = ds.residual_norm.sel(tau=0.2, omega=5.0).values
     assert np.isfinite(r[:, ::4]).all() and np.isnan(r[:, 1::4]).all()
@@ -104,7 +105,7 @@ def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
     reference = run_study(study_file(tmp_path / "ref", members=8192, t_end=5.0, omegas="5.0"),
                           progress=False, log=lambda *a: None)  # fmt: skip
     env = dict(os.environ, PYTHONPATH=str(SRC))
-    cmd = [sys.executable, "-m", "stabdae._cli", "run", str(path), "--quiet", "--no-plots"]
+    cmd = [sys.executable, "-m", "stabdae.study.cli", "run", str(path), "--quiet", "--no-plots"]
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     parts = tmp_path / "out" / "study.nc.parts"
     deadline = time.time() + 120
@@ -127,7 +128,7 @@ def test_default_run_starts_no_cluster(tmp_path):
     # client; stabdae itself imports it only for --workers/--scheduler)
     path = study_file(tmp_path, omegas="5.0")
     code = textwrap.dedent(f"""
-        from stabdae._run import run_study
+        from stabdae.study.run import run_study
         run_study({str(path)!r}, progress=False, log=lambda *a: None)
         try:
             import distributed

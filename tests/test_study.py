@@ -7,8 +7,8 @@ import textwrap
 import numpy as np
 import pytest
 
-from stabdae._cli import main
-from stabdae._study import StudyError, load_study
+from stabdae.study.cli import main
+from stabdae.study.spec import StudyError, load_study
 
 BASE = """
 [model]

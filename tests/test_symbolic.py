@@ -19,7 +19,7 @@ from test_residual_law import constant_laws, relative_law_error
 
 import stabdae
 from conftest import KERNELS, load_scene
-from stabdae._cli import main
+from stabdae.study.cli import main
 from stabdae.symbolic import SymbolicError, System, coordinates, generate, load_spec
 
 SPECS = KERNELS / "specs"

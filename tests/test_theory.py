@@ -210,7 +210,8 @@ def test_along_path_floor_bounds_the_residual():
     law = stabdae.baumgarte(10.0, 1.0)
     x0 = stabdae.sample_perturbations(model, 1, (1e-3, 1e-3), seed=4)[0][0]
     for scheme, tau in (("euler", 0.01), ("midpoint", 0.02)):
-        out = theory.along_path(model, law, scheme, tau, 5.0, x0)
+        path = stabdae.integrate(model, x0, law, scheme, tau, 5.0, tau)
+        out = theory.along_path(model, law, scheme, path)
         assert float(out.q) < 1.0
         bound = max(float(out.bound_start), float(out.epsilon))
         assert (out.residual_norm.values <= bound * (1 + 1e-9)).all()

@@ -82,6 +82,7 @@ system = System(
     forces=[P.mom, 0, 0, 0, 0, 0, 0],  # the driving torque on β
     energy=False,  # the torque does work; there is no first integral to check
     coordinate_units=["rad"] * 7,
+    constraint_units=["m"] * 6,
     simplify=False,  # 7×7 with trigonometry: expansion and CSE suffice
     description=__doc__,
 )

@@ -27,5 +27,7 @@ system = System(
     # at the origin, heading along x, moving forward at 0.5 while turning at 2 rad/s
     reference_state=[0, 0, 0, 0.5, 0, 2.0],
     coordinate_units=["m", "m", "rad"],
+    constraint_units=["m s-1"],
+    energy_units="J",
     description=__doc__,
 )

@@ -33,5 +33,7 @@ system = System(
         0, 0, 0, 0,
     ],
     coordinate_units=["m"] * 4,
+    constraint_units=["m2", "m2"],
+    energy_units="J",
     description=__doc__,
 )

@@ -38,5 +38,7 @@ system = System(
         -l * rate0 * math.sin(theta0), l * rate0 * math.cos(theta0),
     ],
     coordinate_units=["m"] * 4,
+    constraint_units=["m2", "m2", "m2", "m"],
+    energy_units="J",
     description=__doc__,
 )

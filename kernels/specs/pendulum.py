@@ -29,5 +29,7 @@ system = System(
         l * omega0 * math.sin(theta0),
     ],
     coordinate_units=["m", "m"],
+    constraint_units=["m2"],
+    energy_units="m2 s-2",
     description=__doc__,
 )

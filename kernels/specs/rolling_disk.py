@@ -53,5 +53,7 @@ system = System(
     reference_state=[0, 0, R * sp.sin(tilted[theta]), 0, tilted[theta], 0,
                      rolling[x_dot], rolling[y_dot], 0, tilted[phi_dot], 0, w0],
     coordinate_units=["m", "m", "m", "rad", "rad", "rad"],
+    constraint_units=["m", "m s-1", "m s-1"],
+    energy_units="J",
     description=__doc__,
 )

@@ -36,5 +36,7 @@ system = System(
     # stretched out (top dead centre of a normal crank), crank turning at w0
     reference_state=[0, 0, r + l, w0, -r * w0 / l, 0],
     coordinate_units=["rad", "rad", "m"],
+    constraint_units=["m", "m"],
+    energy_units="J",
     description=__doc__,
 )

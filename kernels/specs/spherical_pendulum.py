@@ -34,5 +34,7 @@ system = System(
         0, l * sp.sin(theta0) * rate, 0,
     ],
     coordinate_units=["m", "m", "m"],
+    constraint_units=["m2"],
+    energy_units="J",
     description=__doc__,
 )

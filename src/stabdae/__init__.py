@@ -1,10 +1,13 @@
 """stabdae: stability of the constraint manifold of constrained Lagrangian systems under
 numerical integration, after R. G. Mukharlyamov's constraint-perturbation equations.
 
-The public API is exactly what this module re-exports.
+The public API is exactly what this module re-exports, plus the submodules
+:mod:`stabdae.theory`, :mod:`stabdae.symbolic` and :mod:`stabdae.plots`.  The floors
+below it: :mod:`stabdae.kernels` (compiled), the drivers and definitions here,
+:mod:`stabdae.study` (study files, runs, command line).
 """
 
-from . import theory  # noqa: E402  (submodule: stabdae.theory)
+from . import theory
 from ._adaptive import integrate_adaptive
 from ._ensemble import ensemble, sample_perturbations
 from ._integrate import IntegrationWarning, integrate

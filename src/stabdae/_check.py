@@ -17,10 +17,12 @@ A piece fails when ``max |analytic − finite difference| > rtol · max(1, max |
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._model import Model
+if TYPE_CHECKING:  # model.check() calls in here: the model module imports this one
+    from ._model import Model
 
 _EPS3 = np.finfo(float).eps ** (1 / 3)
 

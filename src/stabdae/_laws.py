@@ -1,4 +1,4 @@
-"""Constraint-perturbation laws ``ġ = Ã g`` (DESIGN §2, the paper's (2.1)–(2.2), (3.9)).
+"""Constraint-perturbation laws ``ġ = Ã g`` (the paper's (2.1)–(2.2), (3.9)).
 
 A law supplies the r × (m + r) matrix ``A`` of (3.9); the full matrix of the residual
 law is
@@ -21,16 +21,13 @@ import numpy as np
 from numba.core.dispatcher import Dispatcher
 
 from ._model import Model, ModelError, probe_output
+from .kernels.jit import is_njit
+from .kernels.rhs import LAW_ACPR, LAW_CONSTANT, LAW_THEOREM5, LAW_USER
 
 __all__ = [
     "Law", "BoundLaw", "baumgarte", "matrix", "theorem5", "none", "user", "acpr", "as_law",
 ]
 
-# Compile-time law kinds of the right-hand-side kernel.
-LAW_CONSTANT = 0  # A given as a runtime matrix
-LAW_THEOREM5 = 1  # A22 = −k W(x) L,  W = h_v h_vᵀ  (m = 0)
-LAW_USER = 2  # A(t, x, p, out) evaluated in the kernel
-LAW_ACPR = 3  # A = 0 plus the correction −γ_s D (G D)⁻¹ g of Ascher, Chin, Petzold, Reich
 
 
 class LawError(ValueError):
@@ -270,7 +267,7 @@ class UserLaw(Law):
 
 @dataclass(frozen=True, repr=False)
 class ACPR(Law):
-    """Ascher–Chin–Petzold–Reich stabilization of the index-1 equations (DESIGN §3, end).
+    """Ascher–Chin–Petzold–Reich stabilization of the index-1 equations (the end of the paper's §3).
 
     ``ẋ = ẋ₁(x) − γ_s D (G D)⁻¹ g(x)`` where ``ẋ₁`` is the right-hand side with ``A = 0``
     and ``D (G D)⁻¹`` is taken in the block form of Ascher et al. for mechanical systems:
@@ -319,7 +316,7 @@ def _real(value, what: str, *, positive: bool = False, nonneg: bool = False) -> 
 
 
 def baumgarte(omega: float | None = None, xi: float = 1.0, k: float | None = None) -> Law:
-    """Baumgarte's law: ``A10 = −ω² I``, ``A11 = −2ξω I``, ``A22 = −k I`` (DESIGN §2).
+    """Baumgarte's law: ``A10 = −ω² I``, ``A11 = −2ξω I``, ``A22 = −k I`` (the paper's ref. [7]).
 
     Parameters
     ----------
@@ -391,7 +388,7 @@ def acpr(gamma: float) -> Law:
 
 def user(fn: Dispatcher) -> Law:
     """A state-dependent law ``A(t, x, p, out)``; ``out`` has shape (r, m + r)."""
-    if not isinstance(fn, Dispatcher):
+    if not is_njit(fn):
         raise LawError(
             "user law: A(t, x, p, out) must be an @njit function (a numba dispatcher), got "
             f"{'a plain Python function' if callable(fn) else type(fn).__name__}"

@@ -1,6 +1,6 @@
 """The model interface: a constrained Lagrangian system as a set of ``@njit`` functions.
 
-A model declares only the pieces its system has (CONTRACT §1, DESIGN §1–3):
+A model declares only the pieces its system has (the paper's §§1–3):
 
 =========== ============================ ========= ==========================================
 piece       signature                    ``out``   when
@@ -25,6 +25,9 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 from numba.core.dispatcher import Dispatcher
+
+from ._check import check_model
+from .kernels.jit import is_njit, python_function
 
 __all__ = ["Model", "ModelError"]
 
@@ -75,8 +78,15 @@ class Model:
         A consistent state ``x* = (q*, v*)`` with ``g(x*, t0) = 0``.
     coordinates : sequence of str, optional
         Names of the n coordinates (default ``q0, q1, …``).
-    coordinate_units : sequence of str, optional
-        CF units of each coordinate (default ``"1"``); velocities get ``"<unit> s-1"``.
+    coordinate_units : str or sequence of str, optional
+        UDUNITS units of each coordinate (default ``"1"``); velocities get
+        ``"<unit> s-1"``.
+    constraint_units : str or sequence of str, optional
+        UDUNITS units of each constraint function: the m entries of ``f``, then the k of
+        ``h`` (default ``"1"``, dimensionless); ``ḟ`` gets ``"<unit> s-1"``.  Datasets
+        label the residual components, and the norms of the residual, with them.
+    energy_units : str, optional
+        UDUNITS units of ``energy`` (default ``"1"``).
     mass, forces, f, f_q, f_t, f_accel, h, h_q, h_v, h_t, energy : numba dispatchers
         The pieces of the model; see the module docstring for signatures.  ``forces`` is
         required; the constraint pieces follow from ``m`` and ``k``; ``mass`` (identity
@@ -120,7 +130,9 @@ class Model:
         h_t: Dispatcher | None = None,
         energy: Dispatcher | None = None,
         coordinates: Sequence[str] | None = None,
-        coordinate_units: Sequence[str] | None = None,
+        coordinate_units: Sequence[str] | str | None = None,
+        constraint_units: Sequence[str] | str | None = None,
+        energy_units: str = "1",
         t0: float = 0.0,
         description: str = "",
     ):
@@ -142,7 +154,11 @@ class Model:
         self.description = description
         self.params = self._validate_params(params)
         self.coordinates = self._validate_names(coordinates)
-        self.coordinate_units = self._validate_units(coordinate_units)
+        self.coordinate_units = self._validate_units(coordinate_units, self.n, "coordinate_units",
+                                                     "n")
+        self.constraint_units = self._validate_units(constraint_units, self.m + self.k,
+                                                     "constraint_units", "r = m + k")
+        self.energy_units = str(energy_units)
 
         given = dict(
             mass=mass, forces=forces, f=f, f_q=f_q, f_t=f_t, f_accel=f_accel,
@@ -193,6 +209,12 @@ class Model:
     @property
     def state_units(self) -> list[str]:
         return list(self.coordinate_units) + [_per_second(u) for u in self.coordinate_units]
+
+    @property
+    def component_units(self) -> list[str]:
+        """Units of the residual components ``(f, ḟ, h)``."""
+        f_units = list(self.constraint_units[: self.m])
+        return f_units + [_per_second(u) for u in f_units] + list(self.constraint_units[self.m:])
 
     @property
     def component_names(self) -> list[str]:
@@ -298,8 +320,6 @@ class Model:
     def check(self, params=None, *, states: int = 3, radius: float = 1e-2, seed: int = 0,
               rtol: float = 1e-6):  # fmt: skip
         """Compare the derivative pieces with finite differences; see :func:`stabdae.check`."""
-        from ._check import check_model
-
         return check_model(self, params, states=states, radius=radius, seed=seed, rtol=rtol)
 
     # ----------------------------------------------------------------- validation
@@ -333,16 +353,15 @@ class Model:
             raise ModelError(f"Model {self.name!r}: coordinate names repeat: {list(names)}")
         return names
 
-    def _validate_units(self, units) -> tuple[str, ...]:
+    def _validate_units(self, units, count: int, what: str, size: str) -> tuple[str, ...]:
         if units is None:
-            return ("1",) * self.n
+            return ("1",) * count
         if isinstance(units, str):
-            return (units,) * self.n
+            return (units,) * count
         out = tuple(str(u) for u in units)
-        if len(out) != self.n:
+        if len(out) != count:
             raise ModelError(
-                f"Model {self.name!r}: coordinate_units must have n={self.n} entries, "
-                f"got {len(out)}"
+                f"Model {self.name!r}: {what} must have {size}={count} entries, got {len(out)}"
             )
         return out
 
@@ -372,7 +391,7 @@ class Model:
                 raise ModelError(f"{where}: k={self.k} nonholonomic constraints need {missing}")
 
     def _require_njit(self, piece: str, fn) -> Dispatcher:
-        if isinstance(fn, Dispatcher):
+        if is_njit(fn):
             return fn
         kind = "a plain Python function" if callable(fn) else f"a {type(fn).__name__}"
         raise ModelError(
@@ -437,9 +456,9 @@ def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs:
     """
     out = np.full(shape, _UNWRITTEN)
     try:
-        fn.py_func(*args, out)
+        python_function(fn)(*args, out)
     except (IndexError, ValueError) as exc:
-        got = _written_shape(fn.py_func, args, shape)
+        got = _written_shape(python_function(fn), args, shape)
         if got is None:  # fails on a larger buffer too: not a shape problem
             out = _probe_boundscheck(where, fn, args, shape, governs)
         else:
@@ -477,7 +496,7 @@ def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs:
 def _probe_boundscheck(where, fn, args, shape, governs) -> np.ndarray:
     from numba import njit
 
-    checked = njit(boundscheck=True)(fn.py_func)
+    checked = njit(boundscheck=True)(python_function(fn))
     out = np.full(shape, _UNWRITTEN)
     try:
         checked(*args, out)

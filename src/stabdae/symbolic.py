@@ -6,7 +6,7 @@ Hand-deriving ``γ``, ``f_accel`` and the Jacobians is where model files go wron
 
 * ``M = ∂²L/∂q̇²`` (omitted when it is the identity),
 * ``γ = (∂²L/∂q̇∂q) q̇ + ∂²L/∂q̇∂t − ∂L/∂q − Q`` so that ``M q̈ = Fᵀλ − γ`` is
-  ``d/dt ∂L/∂q̇ − ∂L/∂q = Q + Fᵀλ`` (DESIGN (3.3); ``Q`` optional non-conservative forces),
+  ``d/dt ∂L/∂q̇ − ∂L/∂q = Q + Fᵀλ`` (the paper's (3.3); ``Q`` optional non-conservative forces),
 * ``f_q``, ``f_t``, and ``f_accel = ∂ḟ/∂q q̇ + ∂ḟ/∂t`` with ``ḟ = f_q q̇ + f_t``, so that
   ``f̈ = f_q q̈ + f_accel``,
 * ``h_q``, ``h_v``, ``h_t``,
@@ -119,7 +119,12 @@ class System:
     t : sympy.Symbol, default :data:`stabdae.symbolic.t`
         The time symbol used in the expressions.
     coordinate_units : sequence of str, optional
-        CF units of the coordinates, passed to :class:`stabdae.Model`.
+        UDUNITS units of the coordinates, passed to :class:`stabdae.Model`.
+    constraint_units : sequence of str, optional
+        UDUNITS units of the holonomic, then the nonholonomic constraint functions, passed
+        to :class:`stabdae.Model`.
+    energy_units : str, optional
+        UDUNITS units of the energy function, passed to :class:`stabdae.Model`.
     t0 : float, default 0.0
         Time at which the reference state is consistent.
     description : str, optional
@@ -151,6 +156,8 @@ class System:
         energy=True,
         t: sp.Symbol = t,
         coordinate_units: Sequence[str] | None = None,
+        constraint_units: Sequence[str] | None = None,
+        energy_units: str | None = None,
         t0: float = 0.0,
         description: str = "",
         simplify: bool = True,
@@ -190,6 +197,8 @@ class System:
             )
         self.energy_spec = energy
         self.coordinate_units = list(coordinate_units) if coordinate_units else None
+        self.constraint_units = list(constraint_units) if constraint_units else None
+        self.energy_units = None if energy_units is None else str(energy_units)
         self.t0 = float(t0)
         self.description = textwrap.dedent(description).strip()
         self.simplify = bool(simplify)
@@ -370,9 +379,12 @@ class System:
         args.append(params)
         args.append("reference_state=reference_state")
         args.append("coordinates=[" + ", ".join(_quote(str(s)) for s in self.q) + "]")
-        if self.coordinate_units:
-            args.append("coordinate_units=[" + ", ".join(map(_quote, self.coordinate_units))
-                        + "]")  # fmt: skip
+        for name in ("coordinate_units", "constraint_units"):
+            units = getattr(self, name)
+            if units:
+                args.append(f"{name}=[" + ", ".join(map(_quote, units)) + "]")
+        if self.energy_units is not None and self.energy_spec is not False:
+            args.append(f"energy_units={_quote(self.energy_units)}")
         args += [f"{piece}={piece}" for piece in pieces]
         if self.t0:
             args.append(f"t0={self.t0!r}")

@@ -1,14 +1,16 @@
-"""The paper's Theorems 3–7 as computations (DESIGN §4–5).
+"""The paper's Theorems 3–7 as computations on matrices.
 
 Continuous time
 
 * :func:`continuous` — Theorem 3: eigenvalues of ``Ã``; decay rate ``−max Re λ(Ã)``.
 * :func:`lyapunov` — Theorem 4: ``2V = αᵀLα``; Sylvester's criterion on the *symmetric part*
-  ``Q = −(LÃ + ÃᵀL)/2`` (the paper writes ``−LÃ``, DESIGN §4 note); with no ``L`` given,
+  ``Q = −(LÃ + ÃᵀL)/2`` (the paper writes ``−LÃ``; its definiteness is what ``V̇ < 0``
+  needs, since ``αᵀ(LÃ)α`` only sees the symmetric part); with no ``L`` given,
   ``L`` solves the continuous Lyapunov equation ``ÃᵀL + LÃ = −I``.
 * :func:`theorem5` — Theorem 5 (nonholonomic, ``m = 0``): ``λ_min(W)`` with ``W = h_v h_vᵀ``
   over given states, ``l₁``, ``l_m``, the proven ``β = k₀ λ_min(W) l₁²/l_m`` beside the
-  paper's printed ``β = k₀ w₀ l₁²/l_m`` (``w₀ = √λ_min(W)``, DESIGN §4 note), ``γ``.
+  paper's printed ``β = k₀ w₀ l₁²/l_m`` (``w₀ = √λ_min(W)``; the two differ when
+  ``w₀ ≠ 1``: ``L = I``, ``W = wI`` decays exactly as ``e^{−kwt}``), ``γ``.
 
 Discrete time
 
@@ -19,9 +21,12 @@ Discrete time
   max-norm (the paper's norm), 2-norm and its norm in the weight ``P = X^{1/2}`` of the
   discrete Lyapunov equation ``RᵀXR − X = −I``; the largest τ for which each condition
   holds (:func:`tau_limit`, by bisection).
-* :func:`along_path` — the same along a trajectory, for state-dependent laws (``Ȧ`` by
-  central differences along the path), and the floor ``ε`` that condition 4 implies from
-  the one-step remainder measured along the path.
+* :func:`along_path` — the same along a given trajectory, for state-dependent laws (``Ȧ``
+  by central differences along the path), and the floor ``ε`` that condition 4 implies
+  from the one-step remainder measured along the path.
+
+A leaf: this module computes on matrices and on trajectories it is given; it samples,
+integrates and formats nothing (the study layer, :mod:`stabdae.study.theory`, does).
 
 Why the weighted norm: with ``m > 0`` the first block row of ``E + τÃ`` is
 ``[I, τI, 0]``, so its max-norm (and 2-norm) is ``≥ 1 + τ`` for every ``τ > 0``; the
@@ -39,8 +44,9 @@ import numpy as np
 import scipy.linalg as sla
 import xarray as xr
 
-from ._laws import Law, as_law
+from ._laws import Law, Theorem5, as_law
 from ._model import Model
+from ._schema import component_coords, provenance, schema_variable, variable
 from ._schemes import as_scheme
 
 __all__ = [
@@ -183,6 +189,9 @@ def tau_limit(A_tilde, scheme, condition: str = "spectral", *, tau_max: float | 
     0 when it fails for arbitrarily small τ (e.g. the max-norm condition when ``m > 0``);
     ``inf`` when it holds up to ``tau_max`` (default ``1e6 / max|λ(Ã)|``).
     """
+    if condition not in CONDITIONS:
+        raise ValueError(f"tau_limit: condition must be one of {tuple(CONDITIONS)}, got "
+                         f"{condition!r}")  # fmt: skip
     fn = CONDITIONS[condition]
     scheme = as_scheme(scheme)
     A = _square(A_tilde, "tau_limit")
@@ -269,8 +278,6 @@ def theorem5(model: Model, law, states, *, t=None, params=None) -> dict:
     ``αᵀWα ≥ w₀²‖α‖²``), ``l1``, ``lm``, ``beta_proven = k₀ λ_min(W) l₁²/l_m``,
     ``beta_printed = k₀ w₀ l₁²/l_m`` and ``gamma_factor = √(l_m/l₁)`` (``γ = ‖g(x₀)‖·that``).
     """
-    from ._laws import Theorem5
-
     law = as_law(law)
     if not isinstance(law, Theorem5):
         raise TypeError(f"theorem5: the law must be stabdae.theorem5(...), got {law}")
@@ -314,13 +321,25 @@ def bound_held(times, norms, alpha0_norm, beta: float, gamma_factor: float, floo
 
 
 # --------------------------------------------------------------------- along a path
-def along_path(model: Model, law, scheme, tau: float, t_end: float, x0=None, *,
-               params=None, weight=None) -> xr.Dataset:  # fmt: skip
+def along_path(model: Model, law, scheme, trajectory: xr.Dataset, *, params=None,
+               weight=None) -> xr.Dataset:  # fmt: skip
     """Theorems 6/7 along one trajectory (state-dependent laws, or a constant law with the
     nonlinear remainder).
 
-    The trajectory is integrated with the scheme itself, every step saved.  Per step
-    ``k``: ``A_k = A(x_k)``; ``Ȧ_k`` by central differences along the path; ``R_k``
+    Parameters
+    ----------
+    model, law, scheme
+        The trajectory's model, law and scheme.
+    trajectory : xarray.Dataset
+        A trajectory of :func:`stabdae.integrate` with that law and scheme, every step
+        stored (``save_dt = tau``): its states ``x_k`` and residuals ``g_k``.
+    params : mapping or array, optional
+        The parameters it was integrated with.
+    weight : array, optional
+        The weight ``P`` of the norm (default: from the discrete Lyapunov equation of
+        ``R_0``).
+
+    Per step ``k``: ``A_k = A(x_k)``; ``Ȧ_k`` by central differences along the path; ``R_k``
     (:func:`step_matrix`); its spectral radius, max-, 2- and weighted norm (``P`` from the
     discrete Lyapunov equation of ``R_0`` unless ``weight`` is given — one norm for the
     whole path, as the theorems need); the remainder ``e_k = g_{k+1} − R_k g_k`` actually
@@ -330,13 +349,17 @@ def along_path(model: Model, law, scheme, tau: float, t_end: float, x0=None, *,
     ``ε = max_k ‖P e_k‖₂ / (1 − q)``, converted to the max-norm with ``‖P⁻¹‖₂``, so that
     Theorems 6/7 give ``‖g_k‖∞ ≤ max(‖P⁻¹‖₂‖P g₀‖₂, ε)``.
     """
-    from ._integrate import integrate
-
     law = as_law(law)
     scheme = as_scheme(scheme)
-    ds = integrate(model, x0, law, scheme, tau, t_end, tau, params=params)
+    tau = float(trajectory.attrs.get("tau", math.nan))
+    save_dt = float(trajectory.attrs.get("save_dt", math.nan))
+    if not (math.isfinite(tau) and math.isclose(save_dt, tau, rel_tol=1e-12)):
+        raise ValueError(
+            "along_path: the trajectory must come from stabdae.integrate with every step "
+            f"stored (save_dt = tau); got tau = {tau:g}, save_dt = {save_dt:g}"
+        )
     p = model.param_vector(params)
-    xs, gs, ts = ds.x.values, ds.residual.values, ds.time.values
+    xs, gs, ts = trajectory.x.values, trajectory.residual.values, trajectory.time.values
     ok = np.all(np.isfinite(xs), axis=1) & np.all(np.isfinite(gs), axis=1)
     N = int(ok.sum())
     As = np.stack([_A_tilde(law, model, xs[k], ts[k], p) for k in range(N)])
@@ -364,28 +387,17 @@ def along_path(model: Model, law, scheme, tau: float, t_end: float, x0=None, *,
         start = Pinv * float(np.linalg.norm(P @ gs[0]))
     else:
         eps, start = math.inf, math.inf
-    step = np.arange(N)
-    out = xr.Dataset(
-        {
-            "spectral_radius": ("step", rho, {"long_name": "spectral radius of R_k", "units": "1"}),
-            "norm_max": ("step", nmax, {"long_name": "max-norm of R_k", "units": "1"}),
-            "norm_2": ("step", n2, {"long_name": "2-norm of R_k", "units": "1"}),
-            "norm_weighted": ("step", nw, {"long_name": "norm of R_k in the path weight P",
-                                           "units": "1"}),
-            "remainder": ("step", rem, {"long_name": "max-norm of g_{k+1} - R_k g_k",
-                                        "units": "1"}),
-            "residual_norm": ("step", np.abs(gs[:N]).max(axis=1),
-                              {"long_name": "max-norm of g along the path", "units": "1"}),
-            "q": ((), q, {"long_name": "max_k of the weighted norm of R_k", "units": "1"}),
-            "epsilon": ((), eps, {"long_name": "floor implied by condition 4 (max-norm)",
-                                  "units": "1"}),
-            "bound_start": ((), start, {"long_name": "|P^-1| |P g0|: the bound's start",
-                                        "units": "1"}),
-        },
-        coords={"step": step, "time": ("step", ts[:N], {"units": "s"})},
-        attrs={"tau": tau, "scheme": scheme.name, "law": str(law), "model": model.name},
-    )  # fmt: skip
-    return out
+    values = {"spectral_radius": rho, "norm_max": nmax, "norm_2": n2, "norm_weighted": nw,
+              "remainder": rem, "residual_norm": np.abs(gs[:N]).max(axis=1), "q": q,
+              "epsilon": eps, "bound_start": start}  # fmt: skip
+    data = {name: schema_variable(name, val, model, dims=("step",) if np.ndim(val) else (),
+                                  key=f"path_{name}")
+            for name, val in values.items()}  # fmt: skip
+    attrs = provenance(model, p, law, scheme, "theory.along_path: Theorems 6/7 along a "
+                       "trajectory", tau=tau)  # fmt: skip
+    coords = {"step": variable("step", np.arange(N), "step index k", "1"),
+              "time": variable("step", ts[:N], "time", "s"), **component_coords(model)}  # fmt: skip
+    return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 def _A_tilde(law: Law, model: Model, x, t, p) -> np.ndarray:
@@ -413,8 +425,8 @@ def predictions(model: Model, law, scheme, tau: float, *, limits: bool = False) 
     return dict(hit)
 
 
-#: predictions by (Ã, tableau, τ): an ensemble of the same law and step repeats them
-#: (0.7 ms, a Lyapunov solve and eigenvalues, against a 0.1 s run of 10⁴ members)
+#: predictions by (Ã, tableau, τ): an ensemble of the same law and step repeats them (a
+#: Lyapunov solve and eigenvalues each time, comparable to a short ensemble's integration)
 _PREDICTIONS: dict = {}
 
 
@@ -439,141 +451,3 @@ def _square(A, who: str) -> np.ndarray:
     if A.ndim != 2 or A.shape[0] != A.shape[1]:
         raise ValueError(f"{who}: Ã must be a square matrix, got shape {A.shape}")
     return A
-
-
-
-# --------------------------------------------------------------------- a study's grid
-def for_study(study, *, path_steps: int = 2000) -> xr.Dataset:
-    """The theorems' predictions at every grid point of a study (``stabdae theory``).
-
-    Constant laws: Theorems 3, 4, 6/7 from ``Ã`` alone, nothing integrated.  Theorem 5
-    laws: ``λ_min(W)`` over a sampled neighbourhood of the manifold (the study's
-    perturbations placed around ``x*``, and the reference trajectory) and the discrete
-    conditions along the reference trajectory (its first ``path_steps`` steps).
-    """
-    from ._ensemble import sample_perturbations
-    from ._integrate import integrate
-
-    model = study.model
-    names = list(study.axes)
-    shape = study.shape
-    cols: dict[str, np.ndarray] = {}
-
-    def put(name, idx, value):
-        if name not in cols:
-            cols[name] = np.full(shape, np.nan)
-        cols[name][idx] = value
-
-    neighbourhood = None
-    per_law: dict = {}
-    for idx, values in study.points():
-        s = study.setup(values)
-        law, scheme, tau = s["law"], s["scheme"], s["tau"]
-        p = model.param_vector(s["params"])
-        if law.is_constant:
-            A = law.A_tilde(model)
-            # what depends on Ã (and the scheme) alone is computed once per distinct law,
-            # not at every τ of the grid: the τ limits are four bisections each
-            key = (A.tobytes(), A.shape, scheme.name, tuple(sorted(scheme.params.items())))
-            if key not in per_law:
-                c, ly = continuous(A), lyapunov(A)
-                per_law[key] = {
-                    "beta_theory": c["beta"], "lyapunov_holds": float(ly["holds"]),
-                    "beta_lyapunov": ly["beta"],
-                    **{f"tau_limit_{k}": tau_limit(A, scheme, k) for k in CONDITIONS},
-                }  # fmt: skip
-            for k, v in per_law[key].items():
-                put(k, idx, v)
-            d = discrete(A, scheme, tau, limits=False)
-            rho = d.spectral_radius
-            put("beta_theory_discrete", idx, -math.log(rho) / tau if rho > 0 else math.inf)
-            for k, v in d.as_dict().items():
-                put(k, idx, v)
-            put("norm_condition", idx, float(d.norm_weighted < 1.0))
-        else:
-            if neighbourhood is None or any(n.startswith("model.") for n in names):
-                x_ref = model.reference_state(p)
-                ens = sample_perturbations(model, study.ensemble["members"],
-                                           study.ensemble["radius"], study.ensemble["seed"],
-                                           params=p)[0]  # fmt: skip
-                traj = integrate(model, x_ref, law, scheme, tau, s["t_end"], s["save_dt"],
-                                 params=p).x.values  # fmt: skip
-                neighbourhood = np.concatenate([ens, traj])
-            c5 = theorem5(model, law, neighbourhood, params=p)
-            for k in ("lambda_min_W", "beta_proven", "beta_printed", "gamma_factor"):
-                put(f"theorem5_{k}", idx, c5[k])
-            t_path = min(s["t_end"], model.t0 + path_steps * tau)
-            t_path = model.t0 + tau * max(2, round((t_path - model.t0) / tau))
-            path = along_path(model, law, scheme, tau, t_path, None, params=p)
-            put("path_spectral_radius_max", idx, float(path.spectral_radius.max()))
-            put("path_norm_weighted_max", idx, float(path.q))
-            put("path_epsilon", idx, float(path.epsilon))
-    data = {k: (names, v, {"long_name": _LONG.get(k, k), "units": _UNITS.get(k, "1")})
-            for k, v in cols.items()}  # fmt: skip
-    ds = xr.Dataset(data, coords={n: (n, v) for n, v in study.axes.items()})
-    ds.attrs.update(model=model.name, law=study.law["kind"], scheme=study.setup()["scheme"].name,
-                    study=str(study.path))  # fmt: skip
-    return ds
-
-
-_LONG = {
-    "beta_theory": "continuous decay rate -max Re eig(A~) (Theorem 3)",
-    "lyapunov_holds": "Theorem 4: Sylvester's criterion on L and the symmetric part of -LA~",
-    "beta_lyapunov": "rate proven by the Lyapunov function, lambda_min(Q)/l_m",
-    "beta_theory_discrete": "discrete decay rate -ln rho(R)/tau",
-    "spectral_radius": "spectral radius of R(tau A~)",
-    "norm_max": "max-norm of R (the paper's norm; Theorems 6, 7)",
-    "norm_2": "2-norm of R",
-    "norm_weighted": "norm of R in the discrete-Lyapunov weight",
-    "norm_condition": "weighted-norm condition holds",
-    "tau_limit_spectral": "largest tau with rho(R) < 1",
-    "tau_limit_max_norm": "largest tau with max-norm of R < 1",
-    "tau_limit_two_norm": "largest tau with 2-norm of R < 1",
-    "tau_limit_weighted_norm": "largest tau with the weighted norm of R < 1",
-}
-_UNITS = {"beta_theory": "s-1", "beta_lyapunov": "s-1", "beta_theory_discrete": "s-1",
-          "tau_limit_spectral": "s", "tau_limit_max_norm": "s", "tau_limit_two_norm": "s",
-          "tau_limit_weighted_norm": "s", "theorem5_beta_proven": "s-1",
-          "theorem5_beta_printed": "s-1"}  # fmt: skip
-
-
-def format_table(ds: xr.Dataset, columns=None) -> str:
-    """A readable table of :func:`for_study`'s dataset, one row per grid point."""
-    columns = columns or [v for v in ("spectral_radius", "norm_max", "norm_weighted",
-                                      "norm_condition", "beta_theory", "beta_theory_discrete",
-                                      "lyapunov_holds", "tau_limit_spectral",
-                                      "theorem5_lambda_min_W", "theorem5_beta_proven",
-                                      "theorem5_beta_printed", "path_spectral_radius_max",
-                                      "path_norm_weighted_max", "path_epsilon")
-                          if v in ds]  # fmt: skip
-    short = {"spectral_radius": "rho(R)", "norm_max": "|R|max", "norm_weighted": "|R|P",
-             "norm_condition": "cond", "beta_theory": "beta", "beta_theory_discrete":
-             "beta_disc", "lyapunov_holds": "Lyap", "tau_limit_spectral": "tau_lim",
-             "theorem5_lambda_min_W": "lmin(W)", "theorem5_beta_proven": "b_proven",
-             "theorem5_beta_printed": "b_printed", "path_spectral_radius_max": "rho_path",
-             "path_norm_weighted_max": "q_path", "path_epsilon": "eps_path"}  # fmt: skip
-    return grid_table(ds, columns, short, flags=("norm_condition", "lyapunov_holds"),
-                      precise=("norm_weighted", "spectral_radius", "path_norm_weighted_max"))
-
-
-def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) -> str:
-    """One row per grid point of ``ds`` (its swept dimensions first, then ``columns``,
-    headed by ``short`` names): ``flags`` as yes/no, ``precise`` with 6 digits (the ones
-    that decide "< 1"), the rest with 4."""
-    dims = list(ds[columns[0]].dims)
-    flat = ds[columns].stack(point=dims) if dims else ds[columns].expand_dims(point=[0])
-    head = [d.split(".", 1)[-1] for d in dims] + [short.get(c, c) for c in columns]
-    rows = []
-    for i in range(flat.sizes["point"]):
-        row = [f"{float(flat[d].values[i]):.4g}" for d in dims]
-        for c in columns:
-            v = float(flat[c].values[i])
-            if c in flags:
-                row.append("yes" if v == 1 else "no")
-            else:
-                row.append(f"{v:.6g}" if c in precise else f"{v:.4g}")
-        rows.append(row)
-    width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
-    lines = ["  ".join(h.rjust(w) for h, w in zip(head, width))]
-    lines += ["  ".join(x.rjust(w) for x, w in zip(r, width)) for r in rows]
-    return "\n".join(lines)

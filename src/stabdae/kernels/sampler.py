@@ -1,4 +1,4 @@
-"""Initial constraint perturbations α⁰ (DESIGN §6).
+"""Initial constraint perturbations α⁰ (Monte Carlo studies of the manifold's stability).
 
 From the consistent reference state ``x*`` (``g(x*) = 0``) each member is displaced by the
 minimum-norm step ``x⁰ = x* + G⁺α⁰``, ``G = ∂g/∂x`` ((2m + k) × 2n), ``G⁺ = Gᵀ(GGᵀ)⁻¹``
@@ -16,9 +16,10 @@ import math
 import numpy as np
 from numba import njit
 
-from ._cache import kernel_key, keyed_cache, tag
-from ._linalg import ldl_inplace, ldl_solve_inplace
-from ._status import Status
+from .._status import Status
+from .cache import kernel_key, keyed_cache, memo, tag
+from .linalg import ldl_inplace, ldl_solve_inplace
+from .rhs import LAW_CONSTANT, kernels_for
 
 #: relative accuracy asked of ``g(x⁰) = α⁰``.  Below ``‖α⁰‖ ≈ 1e-4`` it cannot be met in
 #: double precision (evaluating g near x* cancels terms of size |x|²), so a member whose
@@ -33,9 +34,29 @@ CHUNK = 64
 _FAILED = int(Status.SAMPLING_FAILED)
 
 
+class _Unstabilized:
+    """The bound form of the law ``A = 0``: the sampler evaluates only the residual, which
+    does not depend on the law (the same compiled kernels as any constant law)."""
+
+    code = LAW_CONSTANT
+    fn = None
+
+
+def sampler_for(model):
+    """The compiled perturbation sampler of ``model`` (memoized)."""
+    return memo(model, ("sampler",),
+                lambda: build_sampler(kernels_for(model, _Unstabilized)))  # fmt: skip
+
+
+def residual_rows_for(model):
+    """The compiled ``g(x_i, t0)`` of rows of states of ``model`` (memoized)."""
+    return memo(model, ("residual_rows",),
+                lambda: build_residual_rows(kernels_for(model, _Unstabilized)))  # fmt: skip
+
+
 def build_sampler(K):
     """Compiled Gauss–Newton placement for the kernels ``K``, over chunks of 64 members
-(:data:`CHUNK`; run on threads by :func:`._threads.run_chunks`)."""
+(:data:`CHUNK`; run on threads by :func:`.threads.run_chunks`)."""
     residual, make_workspace = K.residual, K.make_workspace
     N2, ng = 2 * K.n, K.ng
     eps3 = np.finfo(np.float64).eps ** (1.0 / 3.0)

@@ -1,10 +1,10 @@
 """The ensemble kernel: blocks of members in lockstep, structure of arrays, member innermost.
 
-Each work item (a block; ranges of blocks run on threads, :mod:`._threads`) holds a block
+Each work item (a block; ranges of blocks run on threads, :mod:`.threads`) holds a block
 of ``BLOCK`` members as arrays ``X[state, member]`` on the stack.  A step of the block is
 one loop over its members whose body is the member's whole explicit Runge–Kutta step
 (:func:`_member_step_source`): the stages written out, each a call of the stabilized
-right-hand side (:mod:`._rhs`, the user's functions inside), on buffers that live on the
+right-hand side (:mod:`.rhs`, the user's functions inside), on buffers that live on the
 stack (:func:`stack1`, :func:`stack2`).  The step is generated for the scheme's pattern of
 zero / one / other coefficients (:func:`tableau_pattern`): zero terms are left out, factors
 one dropped, the values stay run-time arrays.
@@ -12,15 +12,15 @@ one dropped, the values stay run-time arrays.
 Every function of the step is compiled once and marked ``alwaysinline`` for LLVM
 (``forceinline=True``) rather than inlined at the numba IR level (``inline="always"``):
 numba re-types the whole caller for each IR-inlined call site, which made the compile time
-grow with the number of stages (RK4 on the pendulum: 24 s against 3.8 s now), while LLVM
-inlines the compiled bodies in a fraction of that.  With no calls, no heap arrays and no
+grow with the number of stages (several times longer for RK4), while LLVM inlines the
+compiled bodies in a fraction of that.  With no calls, no heap arrays and no
 branches left in the loop body (the pivot tests of L D Lᵀ and the step's status are
 arithmetic: a chain of branches on them kept LLVM from vectorizing), and every array the
 loop touches an alloca that no other pointer reaches (the parameters, the law's numbers
 and the tableau are copied to the stack first), LLVM keeps the buffers in registers and
 vectorizes the member loop without run-time alias checks.
 
-The library's own multiply-adds are fused (:mod:`._fma`) at the same places as in
+The library's own multiply-adds are fused (:mod:`.fma`) at the same places as in
 :func:`stabdae.integrate`'s step.  Members never interact, so results are bit-for-bit the
 same for any thread count and any block size, and identical to :func:`stabdae.integrate`
 for the same initial state (the same operations in the same order: zero coefficients
@@ -39,8 +39,8 @@ check, now one step at a time with a check and a copy after each: the members wh
 step fails (singular ``S``, mass not SPD, non-finite state) are stopped with the state
 before it, which the in-place update had overwritten; the others recompute the same
 numbers.  Each rollback stops at least one member, so a block rolls back at most once
-per member.  (Testing every step and reducing the test over the block cost about a tenth
-of the loop; a scalar replay of the failed member instead compiled a second copy of the
+per member.  (Testing every step and reducing the test over the block cost a noticeable
+share of the loop; a scalar replay of the failed member instead compiled a second copy of the
 step.)  A member is also stopped when its residual exceeds the divergence threshold at
 a stored sample (it keeps that sample's state).  A stopped member's slot goes on with a
 copy of a running member (numbers nobody reads) so that it does not fail again at every
@@ -52,88 +52,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
-from numba.core import cgutils
-from numba.extending import intrinsic
+from numba import njit
 
-from ._cache import kernel_key, keyed_cache, tag
-from ._fma import fma
-from ._status import Status
+from .._status import Status
+from .cache import kernel_key, keyed_cache, memo, tag
+from .fma import fma
+from .rhs import kernels_for
+from .source import exec_source
+from .workspace import stack1, stack2, stack_int1
 
 BLOCK = 64
 #: the ensemble kernel checks the block at least this often (steps) and keeps a copy of it
 CHECKPOINT = 32
 _NONFINITE = int(Status.NONFINITE_STATE)
 _DIVERGED = int(Status.DIVERGED)
-
-
-def _stack_array(context, builder, shape, dtype=types.float64):
-    arrty = types.Array(dtype, len(shape), "C")
-    ary = context.make_array(arrty)(context, builder)
-    size = 1
-    for s in shape:
-        size *= s
-    # alloca_once puts the buffer in the entry block of the function being compiled: one
-    # buffer per call site, reused by every iteration of the loop around it.
-    data = cgutils.alloca_once(builder, context.get_value_type(dtype), size=max(size, 1))
-    item = context.get_abi_sizeof(context.get_value_type(dtype))
-    intp = lambda v: context.get_constant(types.intp, v)  # noqa: E731
-    strides, acc = [], item
-    for s in reversed(shape):
-        strides.insert(0, intp(acc))
-        acc *= s
-    context.populate_array(ary, data=data, shape=[intp(s) for s in shape], strides=strides,
-                           itemsize=intp(item), meminfo=None)  # fmt: skip
-    return ary._getvalue()
-
-
-def _literal_shape(*dims):
-    if not all(isinstance(d, types.IntegerLiteral) for d in dims):
-        return None
-    return tuple(d.literal_value for d in dims)
-
-
-@intrinsic
-def stack1(typingctx, n):
-    """A float64 array of compile-time length ``n`` on the stack (no meminfo, no NRT).
-
-    Only valid inside the function that calls it (inline the caller at the numba IR level
-    if it is a helper).
-    """
-    shape = _literal_shape(n)
-    if shape is None:
-        return None
-
-    def codegen(context, builder, sig, args):
-        return _stack_array(context, builder, shape)
-
-    return types.Array(types.float64, 1, "C")(n), codegen
-
-
-@intrinsic
-def stack2(typingctx, n0, n1):
-    """A C-ordered float64 array of compile-time shape ``(n0, n1)`` on the stack."""
-    shape = _literal_shape(n0, n1)
-    if shape is None:
-        return None
-
-    def codegen(context, builder, sig, args):
-        return _stack_array(context, builder, shape)
-
-    return types.Array(types.float64, 2, "C")(n0, n1), codegen
-
-
-@intrinsic
-def stack_int1(typingctx, n):
-    """An int64 array of compile-time length ``n`` on the stack."""
-    shape = _literal_shape(n)
-    if shape is None:
-        return None
-
-    def codegen(context, builder, sig, args):
-        return _stack_array(context, builder, shape, types.int64)
-
-    return types.Array(types.int64, 1, "C")(n), codegen
 
 
 def _kind(value: float) -> int:
@@ -160,7 +92,7 @@ def _member_step_source(pattern) -> str:
     Written out rather than looped, so that the body has no inner loops left around the
     inlined right-hand sides and the member loop around it vectorizes for any number of
     stages (LLVM only vectorizes innermost loops and does not unroll a loop this large).
-    The results are those of :func:`stabdae._integrate` 's ``step`` bit for bit: it skips
+    The results are those of :mod:`.steps`' ``step`` bit for bit: it skips
     the same zero terms, starts its sums from −0.0 (exact), and ``1.0 * x`` is ``x``.
     """
     a_kind, b_kind = pattern
@@ -205,9 +137,21 @@ def _member_step_source(pattern) -> str:
 
 
 def _member_step(rhs, N2: int, pattern):
-    namespace = {"rhs": rhs, "stack1": stack1, "N2": N2, "fma": fma}
-    exec(compile(_member_step_source(pattern), f"<stabdae step {pattern}>", "exec"), namespace)
-    return njit(forceinline=True, error_model="numpy")(namespace["member_step"])
+    label = "member_step_" + "".join(map(str, sum(pattern[0], ()) + pattern[1]))
+    ns = exec_source(_member_step_source(pattern), label,
+                     {"rhs": rhs, "stack1": stack1, "N2": N2, "fma": fma})  # fmt: skip
+    return njit(forceinline=True, error_model="numpy")(ns["member_step"])
+
+
+def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
+    """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the kinds of
+    the scheme's coefficients, block and the shape of the law's matrix)."""
+    pattern = tableau_pattern(scheme)
+    shape = bound.matrix.shape
+    n_params = len(model.param_names)
+    return memo(model, ("ensemble", bound.code, bound.fn, pattern, block, shape),
+                lambda: build_soa_kernel(kernels_for(model, bound), pattern, block, n_params,
+                                         shape))  # fmt: skip
 
 
 def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1)):
@@ -218,31 +162,19 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     numbers are run-time arrays)."""
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
-    n, m, k, ng = K.n, K.m, K.k, K.ng
-    N2, r = 2 * n, m + k
-    mk, kk = max(m, 1), max(k, 1)
+    N2, ng = 2 * K.n, K.ng
     B = block
     S_ = len(pattern[1])
     NP = max(n_params, 1)
     LR, LC = law_shape
     member_step = _member_step(rhs, N2, pattern)
-
-    @njit(inline="always")
-    def stack_workspace():
-        """The workspace of ``K.make_workspace`` with every buffer on the stack."""
-        return (
-            stack1(n), stack1(n), stack2(n, n), stack1(n), stack2(mk, n), stack2(kk, n),
-            stack2(kk, n), stack2(n, r), stack2(r, r), stack1(r), stack1(ng), stack1(mk),
-            stack1(kk), stack2(r, ng), stack2(kk, kk), stack1(kk), stack2(r, r), stack1(r),
-            stack1(r),
-        )  # fmt: skip
+    stack_workspace = K.stack_workspace
 
     @njit(error_model="numpy")
     def block_norms(X, t, p, nrm):
         """``‖g‖∞`` of every slot of the block at time ``t`` into ``nrm``: one loop over
-        the slots, vectorized like the step's.  (With one scalar evaluation per running
-        member the pendulum's kernel took 0.194 s against 0.189–0.190 s: one thread,
-        10⁴ members × 10⁴ steps, a sample every 50.)"""
+        the slots, vectorized like the step's (cheaper than one scalar evaluation per
+        running member)."""
         for j in range(B):
             ws = stack_workspace()
             xs = stack1(N2)
@@ -318,7 +250,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         (``out_norm`` NaN after a stop, ``status`` 0 and ``fail_step`` −1 for a member
         that runs to the end), so the driver allocates them empty and the pages of the
         large ``out_norm`` are first touched by the threads that fill them.  Releases the
-        GIL (run by :func:`._threads.run_chunks`)."""
+        GIL (run by :func:`.threads.run_chunks`)."""
         M = x0s.shape[0]
         nsave = out_norm.shape[1]
         # The small run-time inputs copied to the stack, so that the loops read memory no
@@ -454,5 +386,5 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
-    tag(key, stack_workspace, block_norms, retire, stop_failed, block_failed, member_step)
+    tag(key, block_norms, retire, stop_failed, block_failed, member_step)
     return keyed_cache(soa_kernel, key)

@@ -21,7 +21,7 @@ import math
 
 from numba import njit
 
-from ._fma import fma
+from .fma import fma
 
 
 @njit(cache=True, error_model="numpy", forceinline=True)

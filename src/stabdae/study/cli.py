@@ -24,7 +24,7 @@ def _params(pairs: list[str]) -> dict[str, float]:
 
 
 def _cmd_check(args) -> int:
-    from ._loading import load_model
+    from .._loading import load_model
 
     model = load_model(args.model)
     report = model.check(_params(args.param), states=args.states, rtol=args.rtol)
@@ -36,11 +36,11 @@ def _cmd_check(args) -> int:
 def _cmd_integrate(args) -> int:
     from scipy.linalg import expm
 
-    from . import baumgarte, integrate, none
-    from ._dataset import write_netcdf
-    from ._loading import load_model
-    from ._schemes import as_scheme
-    from .theory import step_matrix
+    from .. import baumgarte, integrate, none
+    from .._loading import load_model
+    from .._schema import write_netcdf
+    from .._schemes import as_scheme
+    from ..theory import step_matrix
 
     model = load_model(args.model)
     p = model.param_vector(_params(args.param))
@@ -64,8 +64,8 @@ def _cmd_integrate(args) -> int:
     times = ds.time.values - ds.time.values[0]
     A_tilde = law.A_tilde(model)
     exact = np.array([np.max(np.abs(expm(A_tilde * t) @ g[0])) for t in times])
-    # the scheme's own linear recursion g_{k+1} = R(τÃ) g_k (DESIGN §5), R its stability
-    # polynomial: what the residual does above the truncation floor
+    # the scheme's own linear recursion g_{k+1} = R(τÃ) g_k, R its stability polynomial:
+    # what the residual does above the truncation floor
     R = step_matrix(A_tilde, scheme, args.tau)
     steps = np.rint(times / args.tau).astype(int)
     discrete = np.array([np.max(np.abs(np.linalg.matrix_power(R, s) @ g[0])) for s in steps])
@@ -76,11 +76,12 @@ def _cmd_integrate(args) -> int:
     for i in rows:
         print(f"{ds.time.values[i]:8.3f} {ds.residual_norm.values[i]:14.3e} "
               f"{discrete[i]:14.3e} {exact[i]:16.3e}")  # fmt: skip
+    advice = "shrink --tau" + (" or use --scheme rk4" if scheme.order < 4 else "")
     print(
         "max-norms.  Columns: the integrated residual; the scheme's linear recursion "
-        "(DESIGN §5);\nthe exact law (3.9).  Once the residual reaches the scheme's truncation "
-        f"floor (order tau^{scheme.order})\nit stops following the laws: shrink --tau or use "
-        "--scheme rk4 to lower the floor."
+        "g_(k+1) = R(tau A~) g_k;\nthe exact law (3.9).  Once the residual reaches the "
+        f"scheme's truncation floor (order tau^{scheme.order})\nit stops following the laws: "
+        f"{advice} to lower the floor."
     )
     if "energy" in ds:
         e = ds["energy"].values
@@ -94,12 +95,14 @@ def _cmd_integrate(args) -> int:
 
 
 def _cmd_theory(args) -> int:
-    from . import theory
-    from ._study import load_study
+    from .. import theory
+    from .report import format_table
+    from .spec import load_study
+    from .theory import for_study
 
     study = load_study(args.study)
     print(study.describe())
-    ds = theory.for_study(study)
+    ds = for_study(study)
     law = study.setup()["law"]
     if law.is_constant and not any(n.startswith(("law.", "model.")) for n in study.axes):
         A = law.A_tilde(study.model)
@@ -114,13 +117,13 @@ def _cmd_theory(args) -> int:
         print("Theorems 6/7, largest tau for " + scheme.name + ": " +
               ", ".join(f"{k} {v:.6g}" for k, v in lims.items()))  # fmt: skip
     print("\nper grid point (R = R(τÃ); cond: the weighted-norm condition of Theorems 6/7):")
-    print(theory.format_table(ds))
+    print(format_table(ds))
     return 0
 
 
 def _cmd_run(args) -> int:
-    from ._run import run_study
-    from ._study import load_study
+    from .run import run_study
+    from .spec import load_study
 
     study = load_study(args.study, members=args.members)
     out = run_study(study, args.output, force=args.force, workers=args.workers,
@@ -128,7 +131,7 @@ def _cmd_run(args) -> int:
                     threads=args.threads)  # fmt: skip
     if not args.no_plots:
         try:
-            from .plots import plot_dataset
+            from ..plots import plot_dataset
         except ImportError:
             print("pictures skipped: matplotlib is not installed (pip install 'stabdae[plots]')")
         else:
@@ -138,7 +141,7 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_plot(args) -> int:
-    from .plots import plot_dataset
+    from ..plots import plot_dataset
 
     for path in plot_dataset(args.dataset, args.output):
         print(f"picture written to {path}")
@@ -147,7 +150,7 @@ def _cmd_plot(args) -> int:
 
 def _cmd_generate(args) -> int:
     try:
-        from .symbolic import load_spec
+        from ..symbolic import load_spec
     except ImportError as exc:
         print(f"stabdae generate: error: {exc}", file=sys.stderr)
         return 2
@@ -161,7 +164,7 @@ def _cmd_generate(args) -> int:
           f"{out} in {time.perf_counter() - start:.1f} s")  # fmt: skip
     if args.no_check:
         return 0
-    from ._loading import load_model
+    from .._loading import load_model
 
     model = load_model(out)
     report = model.check()

@@ -17,13 +17,19 @@ import json
 import shutil
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-from ._dataset import write_netcdf
-from ._study import Study, load_study
+from .._ensemble import ensemble
+from .._integrate import IntegrationWarning
+from .._schema import append_history, utc_now, write_netcdf
+from .._version import __version__
+from .report import summary
+from .spec import Study, load_study
+from .theory import axis_units, for_study
 
 __all__ = ["run_study", "run_point", "combine"]
 
@@ -45,15 +51,15 @@ def axis_name(canon: str, all_names) -> str:
 
 def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dataset:
     """The ensemble at one grid point, on the study's common sample grid."""
-    from ._ensemble import ensemble
-
     s = study.setup(values)
     ens = study.ensemble
-    ds = ensemble(study.model, s["law"], s["scheme"], s["tau"], s["t_end"],
-                  members=ens["members"], radius=tuple(ens["radius"]), seed=ens["seed"],
-                  save_dt=s["save_dt"], params=s["params"], epsilon=s["epsilon"],
-                  divergence=s["divergence"], block=ens["block"], threads=threads,
-                  progress=progress)  # fmt: skip
+    with warnings.catch_warnings():  # stopped members: the study's summary counts them
+        warnings.simplefilter("ignore", IntegrationWarning)
+        ds = ensemble(study.model, s["law"], s["scheme"], s["tau"], s["t_end"],
+                      members=ens["members"], radius=tuple(ens["radius"]), seed=ens["seed"],
+                      save_dt=s["save_dt"], params=s["params"], epsilon=s["epsilon"],
+                      divergence=s["divergence"], block=ens["block"], threads=threads,
+                      progress=progress)  # fmt: skip
     if s["stride"] > 1:  # a step spans several samples: NaN between the steps
         stride = s["stride"]
         t0 = float(ds.time[0])
@@ -72,8 +78,6 @@ def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dat
 def _fingerprint(study: Study) -> str:
     h = hashlib.sha256(study.path.read_bytes())
     h.update(json.dumps(study.ensemble, sort_keys=True).encode())
-    from ._version import __version__
-
     h.update(__version__.encode())
     return h.hexdigest()
 
@@ -140,10 +144,8 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
 
 def _with_path_theory(study: Study, ds: xr.Dataset) -> xr.Dataset:
     """State-dependent laws: the discrete conditions of Theorems 6/7 along the reference
-    trajectory at every grid point (:func:`stabdae.theory.for_study`)."""
-    from . import theory
-
-    th = theory.for_study(study)
+    trajectory at every grid point (:func:`.theory.for_study`)."""
+    th = for_study(study)
     names = list(study.axes)
     th = th.rename({n: axis_name(n, names) for n in names})
     keep = [v for v in th.data_vars if v.startswith("path_")]
@@ -201,35 +203,17 @@ def combine(study: Study, parts: Path, npoints: int) -> xr.Dataset:
             ds = ds.set_index(point=dims).unstack("point")
         ds = ds.transpose(*dims, ...)
         for n, d in zip(names, dims):
-            ds[d].attrs.update(long_name=f"swept {n}", units=_axis_units(n))
+            ds[d].attrs.update(long_name=f"swept {n}", units=axis_units(n))
         for n in names:  # a swept value is a coordinate now, not an attribute
             ds.attrs.pop(n.split(".", 1)[1], None)
     for key in _VOLATILE:
         ds.attrs.pop(key, None)
     ds.attrs["study"] = study.path.name
     ds.attrs["swept"] = ", ".join(names) if names else "nothing"
-    ds.attrs["created_at"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
+    ds.attrs["created_at"] = utc_now()
+    append_history(ds.attrs, f"stabdae run {study.path.name}: {npoints} grid points of "
+                   f"{study.ensemble['members']} members combined")  # fmt: skip
     return ds
-
-
-def _axis_units(canon: str) -> str:
-    return {"run.tau": "s", "law.omega": "s-1", "law.k": "s-1"}.get(canon, "1")
-
-
-def summary(ds: xr.Dataset) -> str:
-    """Per grid point: fraction bounded, δ*, median β beside the predictions."""
-    cols = [c for c in ("fraction_bounded", "stability_radius", "beta_median",
-                        "beta_theory_discrete", "spectral_radius", "norm_condition",
-                        "beta_theorem5_proven", "beta_theorem5_printed") if c in ds]  # fmt: skip
-    short = {"fraction_bounded": "bounded", "stability_radius": "delta*", "beta_median":
-             "beta_med", "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
-             "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
-             "beta_theorem5_printed": "b5_printed"}  # fmt: skip
-    from .theory import grid_table
-
-    head = ("summary (bounded: fraction of members; delta*: stability radius; "
-            "beta_pred = -ln rho(R)/tau):")  # fmt: skip
-    return "\n" + head + "\n" + grid_table(ds, cols, short, flags=("norm_condition",)) + "\n"
 
 
 class _Progress:

@@ -2,7 +2,7 @@
 
 For each member, ``‖g(t)‖`` first decays at the rate of the law (continuous: ``−max Re λ(Ã)``;
 discrete: ``−ln ρ(R(τÃ))/τ``) and then settles on a floor set by the scheme's local error
-(DESIGN §5).  The estimator
+(the paper's §5).  The estimator
 
 1. takes the floor as the median of the last fifth of the trace;
 2. takes the upper envelope of the norm from the right (running maximum) and keeps only
@@ -37,7 +37,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._threads import run_chunks
+from .threads import run_chunks
 
 FLOOR_MARGIN = 30.0
 MIN_SAMPLES = 4
@@ -383,7 +383,7 @@ def summarize_rows(norms, times, r0, r1, nvalid, largest, last, fit, do_fit):
     number of leading finite samples, the largest finite sample (NaN when the first is
     not finite), the last of the leading finite ones, and with ``do_fit`` the decay fit
     into ``fit[j]`` (β, γ, floor, transient samples).  One thread; the ensemble runs it
-    on each chunk of members right after integrating it (:mod:`._threads`)."""
+    on each chunk of members right after integrating it (:mod:`.threads`)."""
     T = norms.shape[1]
     row = np.empty(T)
     env = np.empty(T)

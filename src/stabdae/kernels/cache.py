@@ -1,7 +1,7 @@
 """On-disk cache of the compiled model kernels, keyed by what they are compiled from.
 
 A model's kernels are closures over the model's dispatchers and compile-time constants
-(:mod:`._rhs`, :mod:`._soa`).  numba's own ``cache=True`` keys a closure on a pickle of its
+(:mod:`.rhs`, :mod:`.ensemble`).  numba's own ``cache=True`` keys a closure on a pickle of its
 cell contents; a dispatcher pickles with a per-process random id, so that key never
 repeats and the cache never hits.  Here a kernel gets an explicit key instead:
 
@@ -42,10 +42,20 @@ from numba.core.caching import (
     _CacheLocator,
 )
 
-from ._fma import HOST_FMA
+from .fma import HOST_FMA
+from .jit import JIT
 
 __all__ = ["cache_dir", "clear", "fingerprint", "function_fingerprint", "kernel_key", "keyed_cache",
-           "tag"]
+           "memo", "tag"]
+
+
+def memo(model, key: tuple, build):
+    """``build()`` once per model and ``key``, kept on the model: every kernel factory
+    returns new closures, and every new closure is a new compilation."""
+    store = model._kernel_cache
+    if key not in store:
+        store[key] = build()
+    return store[key]
 
 
 def cache_dir() -> Path | None:
@@ -71,11 +81,14 @@ def clear() -> None:
 
 @cache
 def _library_fingerprint() -> str:
-    # the library's multiply-adds compile differently without FMA (._fma)
+    # the library's multiply-adds compile differently without FMA (.fma)
     text = f"numba {numba.__version__} py {sys.version_info[:2]} fma {HOST_FMA}"
     h = hashlib.sha256(text.encode())
-    for path in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(path.name.encode())
+    package = Path(__file__).resolve().parents[1]
+    for path in sorted(package.rglob("*.py")):
+        if path.relative_to(package).parts[0] == "scenes":  # the models are keyed apart
+            continue
+        h.update(path.relative_to(package).as_posix().encode())
         h.update(path.read_bytes())
     return h.hexdigest()
 
@@ -236,7 +249,7 @@ def keyed_cache(dispatcher, key: str | None):
     caching is off); returns the dispatcher."""
     tag(key, dispatcher)
     path = cache_dir()
-    if key is None or path is None:
+    if key is None or path is None or not JIT:
         return dispatcher
     try:
         dispatcher._cache = _KeyedCache(dispatcher.py_func, key, path / "kernels")

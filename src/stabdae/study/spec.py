@@ -1,5 +1,5 @@
-"""Study files (CONTRACT §3): TOML in, a validated :class:`Study` out — before anything
-compiles or runs.
+"""Study files: TOML in, a validated :class:`Study` out — before anything compiles or
+runs.
 
 Every error names the file and the key (``study.toml: [run] tau: must be positive, got
 -0.001``).  Sweep axes are named by their key; an unqualified name is looked up in
@@ -20,10 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ._laws import Law, LawError, baumgarte, matrix, none, theorem5
-from ._loading import load_model
-from ._model import Model, ModelError
-from ._schemes import Scheme, SchemeError, as_scheme
+from .._laws import Law, LawError, baumgarte, matrix, none, theorem5
+from .._loading import load_model
+from .._model import Model, ModelError
+from .._schemes import Scheme, SchemeError, as_scheme
+from .._validate import fixed_time_grid
 
 __all__ = ["Study", "StudyError", "load_study"]
 
@@ -395,12 +396,7 @@ def _check_axis(canon, values, key, fail):
 
 
 def _check_time_grid(tau, span, save_dt):
-    from ._integrate import _whole_multiple
-
+    """The fixed-step grid of one grid point, as :func:`stabdae.ensemble` will check it."""
     if not span > 0:
         raise ValueError(f"t_end must be after t0, got a span of {span:g}")
-    nsteps = _whole_multiple(span, tau, "t_end - t0", "tau")
-    if save_dt is not None:
-        every = _whole_multiple(save_dt, tau, "save_dt", "tau")
-        if nsteps % every:
-            raise ValueError(f"t_end - t0 = {span:g} must be a whole multiple of save_dt")
+    fixed_time_grid(span, tau, save_dt, "[run]")

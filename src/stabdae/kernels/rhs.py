@@ -1,6 +1,6 @@
 """The stabilized right-hand side (3.1), (3.11) compiled for one model and one law kind.
 
-Per evaluation (DESIGN §3)::
+Per evaluation (the paper's §3)::
 
     γ      = forces(t, q, v)                    (3.3)
     F      = [f_q ; h_v]                        (r × n)
@@ -18,8 +18,9 @@ The kernel factory closes over the model's dispatchers and over compile-time fla
 present, m, k, time dependence, law kind).  Absent pieces are replaced by no-op stubs
 behind branches on those constants, which LLVM removes: an identity-mass model compiles
 no factorization of ``M``, a model with ``k = 0`` no nonholonomic block, a scleronomic
-model no ``f_t`` call.  Every buffer lives in a workspace tuple allocated once per
-integration; an evaluation allocates nothing and returns a :class:`~stabdae.Status` code.
+model no ``f_t`` call.  Every buffer lives in a named workspace (:mod:`.workspace`)
+allocated once per integration; an evaluation allocates nothing and returns a
+:class:`~stabdae.Status` code.
 
 Sums start from ``-0.0``, the exact identity of IEEE addition, so LLVM drops the start
 (``0.0 + x`` is not ``x`` for ``x = -0.0`` and would stay in the vectorized loop as one
@@ -30,16 +31,26 @@ from __future__ import annotations
 
 import math
 from collections import namedtuple
+from typing import TYPE_CHECKING
 
-import numpy as np
 from numba import njit
 
-from ._cache import fingerprint, optional_fingerprint, tag
-from ._fma import fma
-from ._laws import LAW_ACPR, LAW_CONSTANT, LAW_THEOREM5, LAW_USER, BoundLaw, LawError
-from ._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace, pinv_solve_sym
-from ._model import Model
-from ._status import Status
+from .._status import Status
+from .cache import fingerprint, memo, optional_fingerprint, tag
+from .fma import fma
+from .jit import python_function
+from .linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace, pinv_solve_sym
+from .workspace import builders
+
+if TYPE_CHECKING:
+    from .._laws import BoundLaw
+    from .._model import Model
+
+# Compile-time law kinds of the right-hand side (a law binds to one, :mod:`stabdae._laws`)
+LAW_CONSTANT = 0  # A given as a runtime matrix
+LAW_THEOREM5 = 1  # A22 = −k W(x) L,  W = h_v h_vᵀ  (m = 0)
+LAW_USER = 2  # A(t, x, p, out) evaluated in the kernel
+LAW_ACPR = 3  # A = 0 plus the correction −γ_s D (G D)⁻¹ g of Ascher, Chin, Petzold, Reich
 
 # Relative pivot thresholds of the L D Lᵀ factorizations: a pivot below RTOL·max|diag|
 # reports a singular matrix instead of producing huge or NaN multipliers.
@@ -92,9 +103,11 @@ def _gram_lower(fq, hv, Y, S, m, rows, n):
             S[i, c] = s
 
 
-Kernels = namedtuple("Kernels", "rhs residual energy project make_workspace n m k ng key")
+Kernels = namedtuple(
+    "Kernels", "rhs residual energy project make_workspace stack_workspace n m k ng key"
+)
 Kernels.__doc__ = """The compiled pieces of one (model, law kind); ``key`` identifies what they
-were compiled from (:mod:`._cache`), ``None`` when a function has no source file."""
+were compiled from (:mod:`.cache`), ``None`` when a function has no source file."""
 
 #: projection after each step: name -> (sweeps per level, tolerance); see ``project``
 PROJECTIONS = {None: (0, 0.0), "post": (1, 0.0), "full": (8, 0.0)}
@@ -109,11 +122,11 @@ def _rejit(fn, absent):
     and ``forceinline=True`` marks it ``alwaysinline`` for LLVM, so that it disappears
     into its callers and the workspace buffers it writes can live in registers.  (Not
     ``inline="always"``: inlining at the numba IR level re-types the caller for every
-    call site and multiplied the ensemble kernel's compile time, see :mod:`._soa`.)
+    call site and multiplied the ensemble kernel's compile time, see :mod:`.ensemble`.)
     """
     if fn is None:
         return absent
-    return njit(error_model="numpy", forceinline=True)(fn.py_func)
+    return njit(error_model="numpy", forceinline=True)(python_function(fn))
 
 
 def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kernels:
@@ -121,17 +134,10 @@ def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kerne
 
     Memoized on the model, since every new closure is a new compilation.  Numeric law data
     (``A``, ``L``, gains) are runtime arguments, so sweeping them reuses the same kernels.
+    ``acpr`` laws need ``multiplier="ldl"`` (the drivers check it).
     """
-    if bound.code == LAW_ACPR and multiplier != "ldl":
-        raise LawError(
-            f"acpr: the correction uses the L D Lᵀ factor of S; multiplier must be 'ldl', "
-            f"got {multiplier!r}"
-        )
-    key = (bound.code, bound.fn, multiplier)
-    cache = model._kernel_cache
-    if key not in cache:
-        cache[key] = _build(model, bound.code, bound.fn, multiplier == "lstsq")
-    return cache[key]
+    return memo(model, (bound.code, bound.fn, multiplier),
+                lambda: _build(model, bound.code, bound.fn, multiplier == "lstsq"))
 
 
 def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
@@ -160,37 +166,12 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     # inlined like the other pieces: a separately compiled user function would carry a
     # symbol name shared by every model's "energy" (see _cache.tag)
     energy_fn = _rejit(model.energy, _nan_energy)
-    mk, kk = max(m, 1), max(k, 1)  # buffers for absent blocks keep a harmless size 1
-
-    @njit(error_model="numpy")
-    def make_workspace():
-        """Every buffer one right-hand-side evaluation needs, allocated once."""
-        return (
-            np.empty(n),  # 0 q
-            np.empty(n),  # 1 v
-            np.empty((n, n)),  # 2 M, then its L D Lᵀ factor
-            np.empty(n),  # 3 γ, then z = M⁻¹γ
-            np.empty((mk, n)),  # 4 f_q
-            np.empty((kk, n)),  # 5 h_v
-            np.empty((kk, n)),  # 6 h_q
-            np.empty((n, r)),  # 7 Y = M⁻¹Fᵀ
-            np.empty((r, r)),  # 8 S, then its L D Lᵀ factor
-            np.empty(r),  # 9 right side of (3.11), then λ
-            np.empty(ng),  # 10 g
-            np.empty(mk),  # 11 scratch of size m (f, f_t, f_accel)
-            np.empty(kk),  # 12 scratch of size k (h, h_t)
-            np.empty((r, ng)),  # 13 A of a user law
-            np.empty((kk, kk)),  # 14 W = h_v h_vᵀ (Theorem 5)
-            np.empty(kk),  # 15 L h (Theorem 5)
-            np.empty((r, r)),  # 16 eigenvectors of S (least-squares multiplier)
-            np.empty(r),  # 17 eigenvalues of S
-            np.empty(r),  # 18 scratch of size r
-        )
+    make_workspace, stack_workspace = builders(n, m, k)
 
     @njit(forceinline=True)
     def residual(t, x, p, ws, g):
         """g = (f, f_q v + f_t, h) of (3.2) into ``g``; fills ws q, v, f_q, h_v, h_q."""
-        q, v, fq, hv, hq, sm, sk = ws[0], ws[1], ws[4], ws[5], ws[6], ws[11], ws[12]
+        q, v, fq, hv, hq, sm, sk = ws.q, ws.v, ws.fq, ws.hv, ws.hq, ws.sm, ws.sk
         for i in range(n):
             q[i] = x[i]
             v[i] = x[n + i]
@@ -221,9 +202,9 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         of Theorem 5).  On a non-zero status ``xdot`` is undefined.  Nothing is checked:
         shapes are fixed by the workspace.
         """
-        q, v, Mw, z, fq, hv, hq = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6]
-        Y, S, rl, g, sm, sk = ws[7], ws[8], ws[9], ws[10], ws[11], ws[12]
-        Aw, W, Lh = ws[13], ws[14], ws[15]
+        q, v, Mw, z, fq, hv, hq = ws.q, ws.v, ws.M, ws.z, ws.fq, ws.hv, ws.hq
+        Y, S, rl, g, sm, sk = ws.Y, ws.S, ws.rl, ws.g, ws.sm, ws.sk
+        Aw, W, Lh = ws.Aw, ws.W, ws.Lh
         residual(t, x, p, ws, g)
         forces(t, q, v, p, z)
 
@@ -293,7 +274,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             rl[i] = s
         _gram_lower(fq, hv, Y, S, m, r, n)
         if LSTSQ:  # redundant constraints: the minimum-norm least-squares λ
-            bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws[16], ws[17], ws[18]) == 0
+            bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws.V, ws.ev, ws.mu) == 0
         else:
             bad_S = ldl_inplace(S, r, S_RTOL) != 0
             ldl_solve_inplace(S, r, rl)  # rl is now λ
@@ -307,7 +288,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         if LAW == LAW_ACPR:
             # − γ_s (δq, δv): δv = Y S⁻¹ (ḟ, h); δq = Y₁ P⁻¹ f with P = f_q M⁻¹ f_qᵀ the
             # leading m × m block of S, whose L D Lᵀ factor is the leading block of S's
-            mu = ws[18]
+            mu = ws.mu
             for i in range(m):
                 mu[i] = g[m + i]
                 sm[i] = g[i]
@@ -344,8 +325,8 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         One sweep with ``tol = 0`` is post-stabilization; sweeps to a small tolerance are
         coordinate projection.
         """
-        Mw, fq, hv, Y, S, g, sm, mu = ws[2], ws[4], ws[5], ws[7], ws[8], ws[10], ws[11], ws[18]
-        q = ws[0]
+        Mw, fq, hv, Y, S, g, sm, mu = ws.M, ws.fq, ws.hv, ws.Y, ws.S, ws.g, ws.sm, ws.mu
+        q = ws.q
         for level in range(2):
             if (level == 0 and m == 0) or (level == 1 and r == 0):
                 continue
@@ -381,7 +362,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
 
     @njit(error_model="numpy")
     def energy(t, x, p, ws):
-        q, v = ws[0], ws[1]
+        q, v = ws.q, ws.v
         for i in range(n):
             q[i] = x[i]
             v[i] = x[n + i]
@@ -393,5 +374,6 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
         *(("lstsq",) if lstsq else ()),
     )  # fmt: skip
-    tag(key, rhs, residual, energy, project, make_workspace)
-    return Kernels(rhs, residual, energy, project, make_workspace, n, m, k, ng, key)
+    tag(key, rhs, residual, energy, project, make_workspace, stack_workspace)
+    return Kernels(rhs, residual, energy, project, make_workspace, stack_workspace, n, m, k,
+                   ng, key)

@@ -21,9 +21,15 @@ two roundings.  Results then differ from an FMA machine's at the roundoff level,
 
 from __future__ import annotations
 
+import math
+from fractions import Fraction
+
 import llvmlite.binding as llvm
+import numpy as np
 from numba import njit, types
 from numba.extending import intrinsic
+
+from .jit import JIT
 
 __all__ = ["HOST_FMA", "fma"]
 
@@ -61,5 +67,29 @@ def _unfused_fma(a, b, c):
     return a * b + c
 
 
-fma = _fused_fma if HOST_FMA else _unfused_fma
+def _exact_fma(a, b, c):
+    """``a · b + c`` rounded once, in Python (without the JIT: Python 3.11 has no
+    ``math.fma``): exact rational arithmetic, then one correctly rounded conversion.  A
+    NumPy float, so that a division by the result follows ``error_model="numpy"`` (inf or
+    NaN, no exception) as the compiled code does."""
+    a, b, c = float(a), float(b), float(c)
+    if not (math.isfinite(a) and math.isfinite(b) and math.isfinite(c)):
+        return np.float64(a) * b + c
+    try:
+        out = float(Fraction(a) * Fraction(b) + Fraction(c))
+    except OverflowError:  # beyond the largest float: inf, as the hardware rounds it
+        return np.float64(a) * b + c
+    if out == 0.0:  # the sign of an exact zero, as IEEE gives it
+        return np.float64(a) * b + c
+    return np.float64(out)
+
+
+def _python_unfused_fma(a, b, c):
+    return np.float64(a) * b + c
+
+
+if not JIT:
+    fma = _exact_fma if HOST_FMA else _python_unfused_fma
+else:
+    fma = _fused_fma if HOST_FMA else _unfused_fma
 fma.__doc__ = """``a · b + c`` rounded once (twice on a CPU without FMA, see :data:`HOST_FMA`)."""

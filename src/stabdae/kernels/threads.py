@@ -2,8 +2,8 @@
 
 The ensemble and sampling kernels are plain ``@njit(nogil=True)`` functions over a range
 of work items (blocks of members), not ``parallel=True`` functions: numba's parfor
-machinery doubles their compile time (measured 12.6 s → 5.8 s on the double pendulum
-kernel), and chunks driven from Python give progress reports and a clean stop on
+machinery about doubles their compile time (figures in ``studies/README.md``), and chunks
+driven from Python give progress reports and a clean stop on
 Ctrl-C between chunks.  Work items never share outputs, so the numbers do not depend on
 the thread count or on which thread ran which chunk.
 """
@@ -27,10 +27,8 @@ def default_threads() -> int:
 def _chunks(items: int, threads: int, per_thread: int = 8) -> list[tuple[int, int]]:
     """Consecutive ranges covering ``range(items)``: about ``per_thread`` per thread, and
     towards the end smaller ones (each at most 1/(2·threads) of what is left, down to one
-    item), so that the threads run out of work at nearly the same time.  With equal
-    chunks the last one kept one thread busy alone (the ensemble kernel alone at 10⁴
-    members on two threads, best of 9, two runs each: 96.9 ms with equal chunks, 95.9 ms
-    with these)."""
+    item), so that the threads run out of work at nearly the same time (with equal chunks
+    the last one kept one thread busy alone)."""
     cap = max(1, -(-items // (threads * per_thread)))
     out, lo = [], 0
     while lo < items:
@@ -86,8 +84,8 @@ _POOLS_LOCK = threading.Lock()
 
 def _pool(threads: int) -> ThreadPoolExecutor:
     """The process's pool of ``threads`` workers, started on first use and kept: starting
-    one per call cost about 0.6 ms (``g(x0)`` of 10⁴ members on 2 threads: 1.0 ms with a
-    new pool, 0.4 ms with this one), and an ensemble makes two such calls."""
+    one per call costs more than a small call's work, and an ensemble makes two such
+    calls."""
     with _POOLS_LOCK:
         pool = _POOLS.get(threads)
         if pool is None:

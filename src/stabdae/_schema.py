@@ -1,0 +1,391 @@
+"""Datasets: one schema for every variable the library writes, one provenance stamp, atomic
+NetCDF writing.
+
+:data:`SCHEMA` names every variable of every dataset (a trajectory, an ensemble, the
+theory of a study's grid, the theory along a path, a study) with its dimensions, long name
+and units, and :func:`schema_variable` builds it.  Units are UDUNITS strings
+(:func:`udunits_ok`).  A variable whose components have different units (the state
+``x = (q, v)``, the residual ``g = (f, ḟ, h)``) has no single ``units`` attribute: its
+``units_per_component`` attribute names the coordinate that holds each component's unit
+(``state_units``, ``component_units``), taken from the model's declaration
+(:class:`stabdae.Model`'s ``coordinate_units`` and ``constraint_units``).  The norm of the
+residual has the constraints' unit when they share one.
+
+:func:`provenance` stamps what produced a dataset; :func:`append_history` adds a line to
+its ``history`` for every later action, with times in one format (:func:`utc_now`).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import re
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from ._status import Status, status_flag_attrs
+from ._version import __version__
+from .kernels.fma import HOST_FMA
+
+__all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "provenance",
+           "schema_markdown", "schema_variable", "trajectory_dataset", "udunits_ok", "utc_now",
+           "variable", "write_netcdf"]  # fmt: skip
+
+#: units markers resolved per model: the state's, the residual components', the residual
+#: norm's (the constraints' common unit), the energy's
+STATE, COMPONENT, RESIDUAL, ENERGY = "@state", "@component", "@residual", "@energy"
+
+_FLAG = {"flag_values": [0, 1], "flag_meanings": "no yes"}
+_HELD = {**_FLAG, "comment": "judged above 10x the member's residual floor, that floor added "
+         "to the bound"}  # fmt: skip
+
+#: name -> (dims, long_name, units, extra attributes).  ``dims`` of theory variables of a
+#: study's grid are the grid's axes (given when built).
+SCHEMA: dict[str, tuple] = {
+    # --- one trajectory (integrate, integrate_adaptive)
+    "x": (("time", "state"), "state x = (q, v)", STATE, {}),
+    "residual": (("time", "component"), "constraint residual g = (f, fdot, h) (3.2)",
+                 COMPONENT, {}),
+    "energy": ("time", "energy (model's energy function)", ENERGY, {}),
+    # --- an ensemble (and, per grid point, a study)
+    "residual_norm": (("member", "time"), "max-norm of the constraint residual", RESIDUAL,
+                      {"comment": "NaN after a member stopped"}),
+    "alpha0": (("member", "component"), "initial perturbation g(x0, t0) achieved", COMPONENT,
+               {}),
+    "alpha0_norm": ("member", "max-norm of alpha0", RESIDUAL, {}),
+    "x0": (("member", "state"), "initial state", STATE, {}),
+    "x_final": (("member", "state"), "final state (last state before a stop)", STATE, {}),
+    "beta": ("member", "fitted decay rate of the residual norm", "s-1",
+             {"comment": "fit on the transient above the floor (stabdae.kernels.decay)"}),
+    "gamma": ("member", "prefactor: max over the transient of |g| exp(beta t)", RESIDUAL, {}),
+    "residual_floor": ("member", "residual level at the end (truncation floor)", RESIDUAL, {}),
+    "max_residual": ("member", "largest residual norm reached", RESIDUAL, {}),
+    "bounded": ("member", "stayed within epsilon and decayed (Definition 2)", "1", _FLAG),
+    "diverged": ("member", "stopped: blew up (diverged, non-finite or singular S)", "1",
+                 _FLAG),
+    "diverged_step": ("member", "step at which the member stopped (-1: ran to the end)", "1",
+                      {}),
+    "status": ("member", "member status", "1", status_flag_attrs()),
+    "steps_accepted": ("member", "accepted steps (adaptive steps)", "1", {}),
+    "rhs_evaluations": ("member", "right-hand-side evaluations (adaptive steps)", "1", {}),
+    "energy_drift": ("member", "energy change E(final) - E(x0)", ENERGY, {}),
+    "fraction_bounded": ((), "fraction of bounded members", "1", {}),
+    "stability_radius": ((), "largest |alpha0| below which every member is bounded", RESIDUAL,
+                         {}),
+    "beta_median": ((), "median fitted decay rate", "s-1", {}),
+    # --- the theorems' predictions (ensemble, study grid)
+    "beta_theory": ((), "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1", {}),
+    "beta_theory_discrete": ((), "discrete decay rate -ln rho(R(tau A~))/tau", "s-1", {}),
+    "spectral_radius": ((), "spectral radius of R(tau A~)", "1", {}),
+    "norm_max": ((), "max-norm of R(tau A~) (the paper's norm; Theorems 6, 7)", "1", {}),
+    "norm_2": ((), "2-norm of R(tau A~)", "1", {}),
+    "norm_weighted": ((), "norm of R(tau A~) in the discrete-Lyapunov weight", "1",
+                      {"comment": "inf when no weight exists (spectral radius >= 1)"}),
+    "norm_condition": ((), "weighted-norm condition of Theorems 6/7 holds", "1", _FLAG),
+    "lyapunov_holds": ((), "Theorem 4: Sylvester's criterion on L and the symmetric part of "
+                       "-LA~", "1", _FLAG),
+    "beta_lyapunov": ((), "rate proven by the Lyapunov function, lambda_min(Q)/l_m", "s-1",
+                      {}),
+    "tau_limit_spectral": ((), "largest tau with rho(R) < 1", "s", {}),
+    "tau_limit_max_norm": ((), "largest tau with max-norm of R < 1", "s", {}),
+    "tau_limit_two_norm": ((), "largest tau with 2-norm of R < 1", "s", {}),
+    "tau_limit_weighted_norm": ((), "largest tau with the weighted norm of R < 1", "s", {}),
+    "lambda_min_W": ((), "min eigenvalue of W = h_v h_v^T over x0 and x_final", "1", {}),
+    "beta_theorem5_proven": ((), "Theorem 5 rate k0 lambda_min(W) l1^2/lm (proven)", "s-1",
+                             {}),
+    "beta_theorem5_printed": ((), "Theorem 5 rate k0 w0 l1^2/lm as printed, w0^2 = "
+                              "lambda_min(W)", "s-1", {}),
+    "gamma_theorem5": ("member", "Theorem 5 prefactor |alpha0|_2 sqrt(lm/l1)", RESIDUAL, {}),
+    "bound_proven_held": ("member", "|alpha(t)| <= gamma exp(-beta t) held, proven beta", "1",
+                          _HELD),
+    "bound_printed_held": ("member", "|alpha(t)| <= gamma exp(-beta t) held, printed beta",
+                           "1", _HELD),
+    "theorem5_lambda_min_W": ((), "Theorem 5: min eigenvalue of W = h_v h_v^T near the "
+                              "manifold", "1", {}),
+    "theorem5_beta_proven": ((), "Theorem 5 rate k0 lambda_min(W) l1^2/lm (proven)", "s-1",
+                             {}),
+    "theorem5_beta_printed": ((), "Theorem 5 rate as printed", "s-1", {}),
+    "theorem5_gamma_factor": ((), "Theorem 5 factor sqrt(lm/l1)", "1", {}),
+    "path_spectral_radius_max": ((), "max spectral radius of R_k along the path", "1", {}),
+    "path_norm_weighted_max": ((), "max weighted norm of R_k along the path", "1", {}),
+    "path_epsilon": ((), "floor implied by condition 4 along the path (max-norm)", RESIDUAL,
+                     {}),
+    # --- Theorems 6/7 along one trajectory (theory.along_path)
+    "path_spectral_radius": ("step", "spectral radius of R_k", "1", {}),
+    "path_norm_max": ("step", "max-norm of R_k", "1", {}),
+    "path_norm_2": ("step", "2-norm of R_k", "1", {}),
+    "path_norm_weighted": ("step", "norm of R_k in the path weight P", "1", {}),
+    "path_remainder": ("step", "max-norm of g_{k+1} - R_k g_k", RESIDUAL, {}),
+    "path_residual_norm": ("step", "max-norm of g along the path", RESIDUAL, {}),
+    "path_q": ((), "max_k of the weighted norm of R_k", "1", {}),
+    "path_bound_start": ((), "|P^-1| |P g0|: the bound's start", RESIDUAL, {}),
+}  # fmt: skip
+
+
+#: the datasets each variable appears in (for the generated reference page)
+_GROUPS = (
+    ("One trajectory: `integrate`, `integrate_adaptive`", ("x", "residual", "residual_norm",
+                                                            "energy")),
+    ("An ensemble: `ensemble` (and per grid point, `stabdae run`)", (
+        "residual_norm", "alpha0", "alpha0_norm", "x0", "x_final", "beta", "gamma",
+        "residual_floor", "max_residual", "bounded", "diverged", "diverged_step", "status",
+        "steps_accepted", "rhs_evaluations", "energy_drift", "fraction_bounded",
+        "stability_radius", "beta_median", "beta_theory", "beta_theory_discrete",
+        "spectral_radius", "norm_max", "norm_weighted", "norm_condition", "lambda_min_W",
+        "beta_theorem5_proven", "beta_theorem5_printed", "gamma_theorem5",
+        "bound_proven_held", "bound_printed_held")),
+    ("The theory of a study's grid: `stabdae theory` (and `path_*` in `stabdae run` with a "
+     "state-dependent law)", (
+        "beta_theory", "beta_theory_discrete", "spectral_radius", "norm_max", "norm_2",
+        "norm_weighted", "norm_condition", "lyapunov_holds", "beta_lyapunov",
+        "tau_limit_spectral", "tau_limit_max_norm", "tau_limit_two_norm",
+        "tau_limit_weighted_norm", "theorem5_lambda_min_W", "theorem5_beta_proven",
+        "theorem5_beta_printed", "theorem5_gamma_factor", "path_spectral_radius_max",
+        "path_norm_weighted_max", "path_epsilon")),
+    ("Theorems 6/7 along a trajectory: `theory.along_path` (the variables drop the `path_` "
+     "prefix)", ("path_spectral_radius", "path_norm_max", "path_norm_2", "path_norm_weighted",
+                 "path_remainder", "path_residual_norm", "path_q", "path_bound_start")),
+)  # fmt: skip
+_MARKER_TEXT = {
+    STATE: "per state entry (`state_units`)",
+    COMPONENT: "per residual component (`component_units`)",
+    RESIDUAL: "the constraints' unit (per component where they differ)",
+    ENERGY: "the model's `energy_units`",
+}
+
+
+def schema_markdown() -> str:
+    """The reference page of :data:`SCHEMA` (``docs/schema.md`` is this text; a test
+    keeps them equal)."""
+    out = [
+        "# Dataset schema",
+        "",
+        "Generated from `stabdae._schema.SCHEMA` (a test checks that this page matches it).",
+        "Units are UDUNITS strings.  A variable whose entries have different units (the",
+        "state `x = (q, v)`, the residual `g = (f, ḟ, h)`) has no `units` attribute but",
+        "`units_per_component`, naming the coordinate (`state_units`, `component_units`)",
+        "that holds each entry's unit, from the model's `coordinate_units` and",
+        "`constraint_units`.  Every dataset has `created_at` (`YYYY-MM-DDThh:mm:ssZ`, UTC)",
+        "and a `history` with one line per action (`<time>: <action> (stabdae <version>)`).",
+    ]
+    for title, names in _GROUPS:
+        out += ["", f"## {title}", "", "| name | dims | units | meaning |", "|---|---|---|---|"]
+        for name in names:
+            dims, long_name, units, _ = SCHEMA[name]
+            dims = (dims,) if isinstance(dims, str) else dims
+            if title.startswith("The theory of a study"):
+                dims = ("grid axes",)
+            elif title.startswith("One trajectory"):
+                dims = tuple(d for d in dims if d != "member")
+            shown = name.removeprefix("path_") if title.startswith("Theorems 6/7") else name
+            unit = _MARKER_TEXT.get(units, f"`{units}`")
+            meaning = long_name.replace("|", "\\|")
+            out.append(f"| `{shown}` | ({', '.join(dims)}) | {unit} | {meaning} |")
+    return "\n".join(out) + "\n"
+
+
+# --------------------------------------------------------------------- units
+_UNIT_SYMBOLS = {
+    "1", "m", "s", "kg", "g", "rad", "sr", "deg", "degree", "N", "J", "W", "Pa", "Hz", "K",
+    "A", "V", "C", "mol", "cd", "min", "h", "day", "percent", "km", "cm", "mm", "um", "nm",
+    "ms", "us", "ns", "kJ", "kN", "kW", "MPa", "kPa", "L", "l",
+}  # fmt: skip
+_FACTOR = re.compile(r"^([A-Za-z]+|1)(?:(?:\^|\*\*)?(-?\d+))?$")
+
+
+def udunits_ok(units: str) -> bool:
+    """Whether ``units`` is a UDUNITS product of known symbols with integer powers
+    (``"1"``, ``"m2 s-1"``, ``"kg m^2"``, ``"m/s"``).  A check of the strings this library
+    writes and models declare, not a parser of the whole UDUNITS grammar."""
+    if not isinstance(units, str) or not units.strip():
+        return False
+    for part in re.split(r"\s*/\s*", units.strip()):
+        if not part:
+            return False
+        for factor in re.split(r"[\s.*]+", part):
+            m = _FACTOR.match(factor)
+            if m is None or m.group(1) not in _UNIT_SYMBOLS:
+                return False
+    return True
+
+
+def _common(units) -> str | None:
+    units = set(units)
+    return units.pop() if len(units) == 1 else None
+
+
+def _resolve_units(marker: str, model) -> dict:
+    """The units attributes of a variable: ``{"units": ...}``, or for a mixed variable
+    ``{"units_per_component": <coordinate>}``."""
+    if marker == STATE:
+        common = _common(model.state_units) if model is not None else None
+        return {"units": common} if common else {"units_per_component": "state_units"}
+    if marker in (COMPONENT, RESIDUAL):
+        common = _common(model.component_units) if model is not None else None
+        if common:
+            return {"units": common}
+        extra = {"units_per_component": "component_units"}
+        if marker == RESIDUAL:
+            extra["comment_units"] = ("max over residual components of different units: in "
+                                      "the unit of the largest component")  # fmt: skip
+        return extra
+    if marker == ENERGY:
+        return {"units": getattr(model, "energy_units", "1")}
+    return {"units": marker}
+
+
+def variable(dims, data, long_name: str, units: str | None, **attrs) -> xr.Variable:
+    """An ``xr.Variable`` with the CF attributes every stabdae variable has."""
+    head = {"long_name": long_name}
+    if units is not None:
+        head["units"] = units
+    return xr.Variable(dims, data, attrs={**head, **attrs})
+
+
+def schema_variable(name: str, data, model=None, dims=None, key: str | None = None
+                    ) -> xr.Variable:  # fmt: skip
+    """Variable ``name`` of :data:`SCHEMA` (entry ``key``, default ``name``) holding
+    ``data``; ``dims`` replaces the schema's (a study grid's axes)."""
+    sdims, long_name, marker, extra = SCHEMA[name if key is None else key]
+    attrs = {"long_name": long_name, **_resolve_units(marker, model), **extra}
+    if "comment" in extra and "comment_units" in attrs:
+        attrs["comment"] = f"{extra['comment']}; {attrs.pop('comment_units')}"
+    elif "comment_units" in attrs:
+        attrs["comment"] = attrs.pop("comment_units")
+    return xr.Variable(sdims if dims is None else dims, data, attrs=attrs)
+
+
+def component_coords(model) -> dict:
+    """The residual components and their units (what ``units_per_component`` of a residual
+    variable names)."""
+    return {
+        "component": variable(
+            "component", model.component_names, "residual component g = (f, fdot, h) (3.2)",
+            None,
+        ),
+        "component_units": variable("component", model.component_units,
+                                    "units of each residual component", None),
+    }  # fmt: skip
+
+
+def model_coords(model, times) -> dict:
+    """Coordinates every stabdae dataset of a model shares: time, state, component, and
+    the units of each state and residual component."""
+    return {
+        "time": variable("time", times, "time", "s"),
+        "state": variable("state", model.state_names, "state component x = (q, v)", None),
+        "state_units": variable("state", model.state_units, "units of each state component",
+                                None),
+        **component_coords(model),
+    }  # fmt: skip
+
+
+# --------------------------------------------------------------------- provenance
+def utc_now() -> str:
+    """The current time, as every stabdae timestamp writes it: ``2026-11-23T01:16:57Z``."""
+    return _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def append_history(attrs: dict, action: str) -> dict:
+    """Add ``"<time>: <action> (stabdae <version>)"`` as a new line of ``attrs["history"]``
+    (CF: one line per action, oldest first); returns ``attrs``."""
+    line = f"{utc_now()}: {action} (stabdae {__version__})"
+    old = attrs.get("history")
+    attrs["history"] = f"{old}\n{line}" if old else line
+    return attrs
+
+
+def flat_attrs(prefix: str, values: dict) -> dict:
+    """Flatten a mapping into NetCDF-storable attributes ``<prefix><key>``."""
+    out = {}
+    for key, val in values.items():
+        if isinstance(val, (bool, np.bool_)):
+            val = int(val)
+        elif isinstance(val, (list, tuple, np.ndarray)):
+            val = np.asarray(val, dtype=np.float64)
+        elif val is None:
+            continue
+        out[f"{prefix}{key}"] = val
+    return out
+
+
+def provenance(model, p: np.ndarray | None, law, scheme, action: str, **run) -> dict:
+    """Global attributes: what produced a dataset (model, parameters, law, scheme, run),
+    when (``created_at``), and its ``history`` started with ``action``."""
+    attrs = {
+        "Conventions": "CF-1.10",
+        "title": f"stabdae: {model.name}",
+        "source": f"stabdae {__version__}",
+        "stabdae_version": __version__,
+        "created_at": utc_now(),
+        "model": model.name,
+        "model_n": model.n,
+        "model_m": model.m,
+        "model_k": model.k,
+        "model_param_names": " ".join(model.param_names),
+        # 1: the library's multiply-adds were fused (kernels.fma); results differ at
+        # roundoff from a machine without FMA, which computes them with two roundings
+        "fused_multiply_add": int(HOST_FMA),
+    }
+    if p is not None:
+        attrs.update(flat_attrs("model_param_", dict(zip(model.param_names, p.tolist()))))
+    if law is not None:
+        law_attrs = law.attrs()
+        attrs["law"] = law_attrs.pop("law")
+        attrs.update(flat_attrs("law_", law_attrs))
+    if scheme is not None:
+        attrs.update(flat_attrs("", scheme.attrs()))
+    attrs.update(flat_attrs("", run))
+    attrs["history"] = f"{attrs['created_at']}: {action} (stabdae {__version__})"
+    return attrs
+
+
+# --------------------------------------------------------------------- datasets
+def trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, run, *,
+                       action: str) -> xr.Dataset:  # fmt: skip
+    """The dataset of one trajectory: ``x``, ``residual``, ``residual_norm``, ``energy``."""
+    data = {
+        "x": schema_variable("x", xs, model),
+        "residual": schema_variable("residual", gs, model),
+        "residual_norm": schema_variable("residual_norm", np.max(np.abs(gs), axis=1), model,
+                                         dims="time"),
+    }  # fmt: skip
+    data["residual_norm"].attrs["comment"] = "NaN after a stop"
+    if model.energy is not None:
+        data["energy"] = schema_variable("energy", es, model)
+    attrs = provenance(model, p, law, scheme, f"{action}: one trajectory", **run)
+    status = Status(status)
+    attrs.update(status=int(status), status_name=status.name.lower(), steps_completed=done)
+    attrs.update({f"status_{k}": v for k, v in status_flag_attrs().items()})
+    return xr.Dataset(data, coords=model_coords(model, times), attrs=attrs)
+
+
+def write_netcdf(ds: xr.Dataset, path, *, compress: int = 4, overwrite: bool = True) -> Path:
+    """Write ``ds`` to ``path`` atomically: a temporary file in the same folder, then rename.
+
+    A reader never sees a half-written file, and a failure leaves any previous file intact.
+    Floating-point and integer variables are zlib-compressed at level ``compress``.
+    """
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    encoding = {}
+    for name, var in ds.data_vars.items():
+        if var.dtype.kind in "fiu" and var.ndim > 0:
+            encoding[name] = {"zlib": True, "complevel": compress, "shuffle": True}
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file ordinary modes
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path

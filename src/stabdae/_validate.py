@@ -1,0 +1,259 @@
+"""Argument validation of the public drivers, in one place.
+
+Every validator takes the value and the name of the function the user called (``who``)
+and returns the cleaned value; every error message starts with that name and says what
+was expected and what came::
+
+    ensemble: tau must be positive and finite, got -0.001
+
+Errors raised by the model, law or scheme constructors on the way are re-raised with the
+caller's name in front, as the same exception type.  Nothing here runs per step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._laws import Law, LawError, as_law, bind_law
+from ._model import Model, ModelError
+from ._schemes import Scheme, SchemeError, as_scheme
+from .kernels.rhs import LAW_ACPR, MULTIPLIERS, PROJECTIONS
+
+__all__ = [
+    "bound_law", "choice", "count", "dtype", "fixed_time_grid", "initial_state", "initial_states",
+    "law", "model", "multiplier", "params", "positive", "projection", "radius", "real",
+    "sample_times", "scheme", "seed", "span", "whole_multiple",
+]  # fmt: skip
+
+
+def _prefixed(exc: Exception, who: str) -> Exception:
+    """``exc`` again, of the same type, with ``who: `` in front of its message."""
+    msg = str(exc)
+    if msg.startswith(f"{who}:"):
+        return exc
+    try:
+        return type(exc)(f"{who}: {msg}")
+    except TypeError:  # an exception type with another constructor
+        return ValueError(f"{who}: {msg}")
+
+
+def model(value, who: str) -> Model:
+    if not isinstance(value, Model):
+        raise TypeError(f"{who}: model must be a stabdae.Model (see stabdae.load_model), got "
+                        f"{type(value).__name__}")  # fmt: skip
+    return value
+
+
+def law(value, who: str, example: str = "stabdae.baumgarte(omega=10.0, xi=1.0)") -> Law:
+    if value is None:
+        raise ValueError(f"{who}: give a law, e.g. {example}")
+    try:
+        return as_law(value)
+    except LawError as exc:
+        raise _prefixed(exc, who) from None
+
+
+def bound_law(value: Law, model_: Model, who: str):
+    """The law bound to the model (its matrix checked against the model's sizes)."""
+    try:
+        return bind_law(value, model_)
+    except (LawError, ModelError) as exc:
+        raise _prefixed(exc, who) from None
+
+
+def scheme(value, who: str, default: str | None = None) -> Scheme:
+    try:
+        return as_scheme(default if value is None else value)
+    except SchemeError as exc:
+        raise _prefixed(exc, who) from None
+
+
+def params(model_: Model, values, who: str) -> np.ndarray:
+    """The parameter vector ``p`` of ``model_`` with ``values`` applied."""
+    try:
+        return model_.param_vector(values)
+    except ModelError as exc:
+        raise _prefixed(exc, who) from None
+
+
+def _float(value, name: str, who: str) -> float:
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: {name} must be a real number, got {value!r}") from None
+
+
+def real(value, name: str, who: str) -> float:
+    out = _float(value, name, who)
+    if not math.isfinite(out):
+        raise ValueError(f"{who}: {name} must be finite, got {value!r}")
+    return out
+
+
+def positive(value, name: str, who: str) -> float:
+    out = _float(value, name, who)
+    if not (math.isfinite(out) and out > 0):
+        raise ValueError(f"{who}: {name} must be positive and finite, got {value!r}")
+    return out
+
+
+def count(value, name: str, who: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"{who}: {name} must be a positive integer, got {value!r}")
+    return int(value)
+
+
+def seed(value, who: str) -> int:
+    """A seed that the dataset can store (and a later run repeat): a non-negative integer."""
+    if isinstance(value, np.random.Generator):
+        raise TypeError(
+            f"{who}: seed must be a non-negative integer, got a numpy Generator: the dataset "
+            "stores the seed so that the run can be repeated (draw the initial states with "
+            "stabdae.sample_perturbations(..., seed=generator) and pass them as x0 instead)"
+        )
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise ValueError(f"{who}: seed must be a non-negative integer, got {value!r}")
+    return int(value)
+
+
+def choice(value, name: str, options, who: str):
+    if value not in options:
+        raise ValueError(f"{who}: {name} must be one of {tuple(options)}, got {value!r}")
+    return value
+
+
+def span(t0: float, t_end, who: str) -> float:
+    """``t_end − t0``, positive and finite."""
+    try:
+        out = float(t_end) - t0
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: t_end must be a real number, got {t_end!r}") from None
+    if not (math.isfinite(out) and out > 0):
+        raise ValueError(f"{who}: t_end must be after t0 = {t0:g}, got t_end = {t_end!r}")
+    return out
+
+
+def whole_multiple(total: float, unit: float, total_name: str, unit_name: str,
+                   who: str) -> int:  # fmt: skip
+    """``total / unit`` when it is a whole number (to 1e-9 relative), else an error that
+    gives the nearest values that are."""
+    count_ = round(total / unit)
+    if count_ < 1 or abs(count_ * unit - total) > 1e-9 * max(total, unit):
+        lo, hi = max(1, math.floor(total / unit)), max(1, math.ceil(total / unit))
+        near = f"{lo * unit:g}" if lo == hi else f"{lo * unit:g} or {hi * unit:g}"
+        raise ValueError(
+            f"{who}: {total_name} = {total:g} must be a whole multiple of {unit_name} = "
+            f"{unit:g} (fixed steps; samples on the step grid); nearest: {near}"
+        )
+    return count_
+
+
+def fixed_time_grid(span_: float, tau: float, save_dt, who: str, *,
+                    default_samples: int | None = None) -> tuple[int, int]:  # fmt: skip
+    """``(steps, steps between stored samples)`` of a fixed-step run over ``span_``.
+
+    ``save_dt=None`` stores every step, or about ``default_samples`` samples when given
+    (the largest spacing that divides the steps)."""
+    nsteps = whole_multiple(span_, tau, "t_end - t0", "tau", who)
+    if save_dt is None:
+        if default_samples is None:
+            return nsteps, 1
+        every = max(1, nsteps // default_samples)
+        while nsteps % every:
+            every -= 1
+        return nsteps, every
+    every = whole_multiple(positive(save_dt, "save_dt", who), tau, "save_dt", "tau", who)
+    if nsteps % every:
+        raise ValueError(
+            f"{who}: t_end - t0 = {span_:g} must be a whole multiple of save_dt = {save_dt:g}"
+        )
+    return nsteps, every
+
+
+def sample_times(t0: float, t_end: float, save_dt, who: str) -> np.ndarray:
+    """Sample times after ``t0`` of an adaptive run: every ``save_dt``, the last one at
+    ``t_end`` (only ``t_end`` when ``save_dt`` is None)."""
+    if save_dt is None:
+        return np.array([t_end])
+    save_dt = positive(save_dt, "save_dt", who)
+    n = max(1, int(math.ceil((t_end - t0) / save_dt - 1e-9)))
+    out = np.minimum(t0 + save_dt * np.arange(1, n + 1), t_end)
+    out[-1] = t_end
+    return out
+
+
+def initial_state(model_: Model, x0, p, who: str) -> np.ndarray:
+    """``x0`` as a finite float64 (2n,) array; the reference state when None."""
+    if x0 is None:
+        x0 = model_.reference_state(p)
+    try:
+        x0 = np.array(x0, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: x0 must be an array of numbers, got {type(x0).__name__}") \
+            from None
+    if x0.shape != (2 * model_.n,):
+        raise ValueError(
+            f"{who}: x0 must have shape (2n,) = ({2 * model_.n},) for model {model_.name!r}, "
+            f"got {x0.shape}"
+        )
+    if not np.all(np.isfinite(x0)):
+        raise ValueError(f"{who}: x0 has non-finite entries")
+    return x0
+
+
+def initial_states(model_: Model, x0, who: str) -> np.ndarray:
+    """``x0`` as a C-contiguous float64 (members, 2n) array (rows may be non-finite: those
+    members get a status)."""
+    try:
+        x0 = np.array(x0, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: x0 must be an array of numbers, got {type(x0).__name__}") \
+            from None
+    if x0.ndim != 2 or x0.shape[1] != 2 * model_.n or x0.shape[0] < 1:
+        raise ValueError(
+            f"{who}: x0 must have shape (members, 2n) = (M, {2 * model_.n}) for model "
+            f"{model_.name!r}, got {x0.shape}"
+        )
+    return np.ascontiguousarray(x0)
+
+
+def radius(value, who: str) -> tuple[float, float]:
+    """``(low, high)`` of a radius given as a number or a pair of positive numbers."""
+    try:
+        vals = np.atleast_1d(np.asarray(value, dtype=np.float64))
+    except (TypeError, ValueError):
+        vals = np.array([np.nan])
+    if vals.shape not in ((1,), (2,)) or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
+        raise ValueError(
+            f"{who}: radius must be a positive number or a pair (low, high) of positive "
+            f"numbers, got {value!r}"
+        )
+    low, high = float(vals[0]), float(vals[-1])
+    if low > high:
+        raise ValueError(f"{who}: radius low = {low:g} exceeds high = {high:g}")
+    return low, high
+
+
+def multiplier(value, bound, who: str) -> str:
+    choice(value, "multiplier", MULTIPLIERS, who)
+    if bound.code == LAW_ACPR and value != "ldl":
+        raise LawError(
+            f"{who}: the acpr correction uses the L D Lᵀ factor of S; multiplier must be "
+            f"'ldl', got {value!r}"
+        )
+    return value
+
+
+def projection(value, who: str) -> tuple[int, float]:
+    """``(sweeps, tolerance)`` of a ``projection`` argument (None, "post" or "full")."""
+    if value not in PROJECTIONS:
+        raise ValueError(f"{who}: projection must be None, 'post' or 'full', got {value!r}")
+    return PROJECTIONS[value]
+
+
+def dtype(value, name: str, options, who: str) -> np.dtype:
+    choice(str(value), name, tuple(options), who)
+    return np.dtype(str(value))
+

@@ -1,0 +1,279 @@
+"""Adaptive steps with an embedded Runge–Kutta pair (Dormand–Prince 5(4)): the loop of one
+trajectory (:func:`adaptive_for`, behind :func:`stabdae.integrate_adaptive`) and the
+per-member ensemble kernel (:func:`adaptive_ensemble_for`, behind
+``stabdae.ensemble(rtol=...)``), both running the one loop of :func:`_adaptive_loop`.
+
+Local error control ``err = ‖e / (atol + rtol·max(|x|, |x̃|))‖_RMS ≤ 1`` per step,
+``e = τ Σ (b_i − b̂_i) k_i``, the step updated by ``0.9 err^{−1/5}`` within ``[0.2, 10]``
+(no growth right after a rejection), the first step chosen as in Hairer, Nørsett & Wanner
+(II.4).  Steps end exactly on the sample times.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .._status import Status
+from .cache import kernel_key, keyed_cache, memo, tag
+from .rhs import kernels_for
+from .steps import sample_writer
+
+__all__ = ["adaptive_ensemble_for", "adaptive_for"]
+
+_STEP_TOO_SMALL = int(Status.STEP_TOO_SMALL)
+_MAX_STEPS = int(Status.MAX_STEPS)
+_DIVERGED = int(Status.DIVERGED)
+
+
+def adaptive_for(model, bound, multiplier: str = "ldl"):
+    """The compiled adaptive loop for ``model`` under the law's kind (memoized)."""
+    return memo(model, ("adaptive", bound.code, bound.fn, multiplier),
+                lambda: _build_adaptive(kernels_for(model, bound, multiplier)))
+
+
+def adaptive_ensemble_for(model, bound):
+    """The compiled per-member adaptive ensemble kernel (memoized)."""
+    return memo(model, ("adaptive-ensemble", bound.code, bound.fn),
+                lambda: _build_adaptive_ensemble(kernels_for(model, bound)))
+
+
+def _adaptive_loop(K, save, label: str):
+    """The Dormand–Prince loop of one trajectory, with ``save(j, t, x, p, ws, g, out)``
+    storing sample ``j`` (it returns True to stop the trajectory: status DIVERGED).
+
+    ``run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c, rtol, atol,
+    h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g, out, counts)`` integrates ``x`` in
+    place from ``t0`` through every time in ``save_times`` (increasing, after ``t0``);
+    sample ``j + 1`` is saved at ``save_times[j]`` (sample 0 at ``t0``).  ``sweeps > 0``
+    projects the state after each accepted step (``K.project``; the first stage of the
+    next step is then evaluated anew).  ``counts`` receives (accepted, rejected, rhs
+    evaluations).  Returns ``(status, samples written)``; on a failure ``x`` is the last
+    accepted state.  It allocates nothing: the buffers are the caller's.  ``label`` keeps
+    the symbol names of loops with different ``save`` functions apart (:func:`.cache.tag`).
+    """
+    rhs, project = K.rhs, K.project
+    N2 = 2 * K.n
+
+    @njit(error_model="numpy")
+    def f_eval(t, x, p, law_mat, law_scal, ws, xdot):
+        # one out-of-line copy of the (inlined) right-hand side, called from three places:
+        # compiling the inlined body once instead of three times halves the compile time
+        return rhs(t, x, p, law_mat, law_scal, ws, xdot)
+
+    @njit(error_model="numpy")
+    def rms_error(x, xnew, err, rtol, atol):
+        s = 0.0
+        for l in range(N2):
+            sc = atol + rtol * max(abs(x[l]), abs(xnew[l]))
+            e = err[l] / sc
+            s += e * e
+        return math.sqrt(s / N2)
+
+    @njit(error_model="numpy")
+    def run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c, rtol,
+            atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g, out, counts):  # fmt: skip
+        s = tab_b.shape[0]
+        t = t0
+        nfev = 0
+        counts[0], counts[1], counts[2] = 0, 0, 0
+        if save(0, t, x, p, ws, g, out):
+            return _DIVERGED, 1
+        st = f_eval(t, x, p, law_mat, law_scal, ws, k[0])
+        nfev += 1
+        if st != 0:
+            counts[2] = nfev
+            return st, 1
+        # first step (Hairer–Nørsett–Wanner II.4): h from ‖x‖/‖ẋ‖, then from ‖ẍ‖
+        h = h0
+        if h <= 0.0:
+            d0 = d1 = 0.0
+            for l in range(N2):
+                sc = atol + rtol * abs(x[l])
+                d0 += (x[l] / sc) ** 2
+                d1 += (k[0, l] / sc) ** 2
+            d0, d1 = math.sqrt(d0 / N2), math.sqrt(d1 / N2)
+            h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+            h = min(h, save_times[save_times.shape[0] - 1] - t0)
+            for l in range(N2):
+                xs[l] = x[l] + h * k[0, l]
+            st = f_eval(t + h, xs, p, law_mat, law_scal, ws, k[1])
+            nfev += 1
+            if st == 0:
+                d2 = 0.0
+                for l in range(N2):
+                    sc = atol + rtol * abs(x[l])
+                    d2 += ((k[1, l] - k[0, l]) / sc) ** 2
+                d2 = math.sqrt(d2 / N2) / h
+                if max(d1, d2) <= 1e-15:
+                    h1 = max(1e-6, h * 1e-3)
+                else:
+                    h1 = (0.01 / max(d1, d2)) ** 0.2
+                h = min(100.0 * h, h1)
+        accepted = rejected = 0
+        j = 0
+        nsave = save_times.shape[0]
+        after_reject = False
+        while j < nsave:
+            target = save_times[j]
+            if accepted + rejected >= max_steps:
+                counts[0], counts[1], counts[2] = accepted, rejected, nfev
+                return _MAX_STEPS, j + 1
+            hit = False
+            hh = h
+            if t + hh >= target - 1e-12 * abs(target):
+                hh = target - t
+                hit = True
+            if hh <= 1e-14 * max(1.0, abs(t)):
+                counts[0], counts[1], counts[2] = accepted, rejected, nfev
+                return _STEP_TOO_SMALL, j + 1
+            # stages 1 … s−1 (stage 0 is ẋ at (t, x): first same as last)
+            st = 0
+            for i in range(1, s):
+                for l in range(N2):
+                    acc = 0.0
+                    for m_ in range(i):
+                        acc += tab_a[i, m_] * k[m_, l]
+                    xs[l] = x[l] + hh * acc
+                st = f_eval(t + tab_c[i] * hh, xs, p, law_mat, law_scal, ws, k[i])
+                nfev += 1
+                if st != 0:
+                    break
+            finite = st == 0
+            if finite:
+                for l in range(N2):
+                    acc = 0.0
+                    acc_e = 0.0
+                    for i in range(s):
+                        acc += tab_b[i] * k[i, l]
+                        acc_e += (tab_b[i] - tab_bh[i]) * k[i, l]
+                    xnew[l] = x[l] + hh * acc
+                    err[l] = hh * acc_e
+                    if not (math.isfinite(xnew[l]) and math.isfinite(err[l])):
+                        finite = False
+            if not finite:  # a failed evaluation or overflow: shrink hard and retry
+                rejected += 1
+                h = 0.25 * hh
+                after_reject = True
+                continue
+            e = rms_error(x, xnew, err, rtol, atol)
+            if e <= 1.0:
+                accepted += 1
+                t = target if hit else t + hh
+                for l in range(N2):
+                    x[l] = xnew[l]
+                    k[0, l] = k[s - 1, l]  # FSAL: the last stage is ẋ at the new point
+                if sweeps > 0:
+                    st = project(t, x, p, ws, sweeps, tol)
+                    if st == 0:
+                        st = f_eval(t, x, p, law_mat, law_scal, ws, k[0])
+                        nfev += 1
+                    if st != 0:
+                        counts[0], counts[1], counts[2] = accepted, rejected, nfev
+                        return st, j + 1
+                fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e ** -0.2))
+                if after_reject:
+                    fac = min(fac, 1.0)
+                after_reject = False
+                h = hh * fac if not hit else max(h, hh * fac)
+                if hit:
+                    j += 1
+                    if save(j, t, x, p, ws, g, out):
+                        counts[0], counts[1], counts[2] = accepted, rejected, nfev
+                        return _DIVERGED, j + 1
+            else:
+                rejected += 1
+                h = hh * max(0.2, 0.9 * e ** -0.2)
+                after_reject = True
+        counts[0], counts[1], counts[2] = accepted, rejected, nfev
+        return 0, nsave + 1
+
+    tag(kernel_key(K.key, f"adaptive-loop-{label}"), f_eval, rms_error, run)
+    return run
+
+
+def _build_adaptive(K):
+    make_workspace = K.make_workspace
+    write = sample_writer(K)
+    N2, ng = 2 * K.n, K.ng
+
+    @njit(forceinline=True)
+    def save(j, t, x, p, ws, g, out):
+        write(j, t, x, p, ws, g, out[0], out[1], out[2])
+        return False
+
+    run = _adaptive_loop(K, save, "trajectory")
+
+    @njit(error_model="numpy")
+    def adaptive_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
+                        tab_c, rtol, atol, h0, max_steps, sweeps, tol, out_x, out_g, out_e,
+                        counts):  # fmt: skip
+        """One trajectory from ``x0``: the loop of :func:`_adaptive_loop` writing state,
+        residual and energy samples into ``out_x``, ``out_g``, ``out_e``."""
+        ws = make_workspace()
+        k = np.empty((tab_b.shape[0], N2))
+        xs, xnew, err, g = np.empty(N2), np.empty(N2), np.empty(N2), np.empty(ng)
+        x = x0.copy()
+        return run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c,
+                   rtol, atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g,
+                   (out_x, out_g, out_e), counts)  # fmt: skip
+
+    keyed_cache(adaptive_kernel, kernel_key(K.key, "adaptive-dopri5"))
+    return adaptive_kernel
+
+
+def _build_adaptive_ensemble(K):
+    make_workspace, residual, energy = K.make_workspace, K.residual, K.energy
+    N2, ng = 2 * K.n, K.ng
+
+    @njit(forceinline=True)
+    def save(j, t, x, p, ws, g, out):
+        norms, i, divergence = out
+        residual(t, x, p, ws, g)
+        r = 0.0
+        for l in range(ng):
+            r = max(r, abs(g[l]))
+        if not math.isfinite(r):
+            r = math.inf
+        norms[i, j] = r
+        return not (r <= divergence)
+
+    run = _adaptive_loop(K, save, "ensemble")
+
+    @njit(nogil=True, error_model="numpy")
+    def ensemble_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
+                        tab_c, rtol, atol, h0, max_steps, divergence, norms, x_final, status,
+                        fail_step, e0, e1, steps, nfev, lo, hi):  # fmt: skip
+        """Members ``lo … hi − 1``, each with its own step control; the buffers are
+        allocated once per call (a chunk of members), not per member."""
+        ws = make_workspace()
+        k = np.empty((tab_b.shape[0], N2))
+        xs, xnew, err, g = np.empty(N2), np.empty(N2), np.empty(N2), np.empty(ng)
+        x = np.empty(N2)
+        counts = np.zeros(3, dtype=np.int64)
+        tend = save_times[save_times.shape[0] - 1]
+        for i in range(lo, hi):
+            for l in range(N2):
+                x[l] = x0[i, l]
+            if status[i] != 0:  # not placed: keep it out
+                for l in range(N2):
+                    x_final[i, l] = x[l]
+                continue
+            e0[i] = energy(t0, x, p, ws)
+            st, written = run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
+                              tab_c, rtol, atol, h0, max_steps, 0, 0.0, ws, k, xs, xnew,
+                              err, g, (norms, i, divergence), counts)  # fmt: skip
+            for l in range(N2):
+                x_final[i, l] = x[l]
+            status[i] = st
+            steps[i] = counts[0]
+            nfev[i] = counts[2]
+            if st != 0:
+                fail_step[i] = counts[0]
+            else:
+                e1[i] = energy(tend, x, p, ws)
+
+    keyed_cache(ensemble_kernel, kernel_key(K.key, "adaptive-ensemble-dopri5"))
+    return ensemble_kernel

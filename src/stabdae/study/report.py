@@ -1,0 +1,64 @@
+"""Tables of a study's grid: the theorems' predictions (``stabdae theory``) and the
+measurements beside them (``stabdae run``), one row per grid point."""
+
+from __future__ import annotations
+
+import xarray as xr
+
+__all__ = ["format_table", "grid_table", "summary"]
+
+
+def format_table(ds: xr.Dataset, columns=None) -> str:
+    """A readable table of :func:`for_study`'s dataset, one row per grid point."""
+    columns = columns or [v for v in ("spectral_radius", "norm_max", "norm_weighted",
+                                      "norm_condition", "beta_theory", "beta_theory_discrete",
+                                      "lyapunov_holds", "tau_limit_spectral",
+                                      "theorem5_lambda_min_W", "theorem5_beta_proven",
+                                      "theorem5_beta_printed", "path_spectral_radius_max",
+                                      "path_norm_weighted_max", "path_epsilon")
+                          if v in ds]  # fmt: skip
+    short = {"spectral_radius": "rho(R)", "norm_max": "|R|max", "norm_weighted": "|R|P",
+             "norm_condition": "cond", "beta_theory": "beta", "beta_theory_discrete":
+             "beta_disc", "lyapunov_holds": "Lyap", "tau_limit_spectral": "tau_lim",
+             "theorem5_lambda_min_W": "lmin(W)", "theorem5_beta_proven": "b_proven",
+             "theorem5_beta_printed": "b_printed", "path_spectral_radius_max": "rho_path",
+             "path_norm_weighted_max": "q_path", "path_epsilon": "eps_path"}  # fmt: skip
+    return grid_table(ds, columns, short, flags=("norm_condition", "lyapunov_holds"),
+                      precise=("norm_weighted", "spectral_radius", "path_norm_weighted_max"))
+
+
+def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) -> str:
+    """One row per grid point of ``ds`` (its swept dimensions first, then ``columns``,
+    headed by ``short`` names): ``flags`` as yes/no, ``precise`` with 6 digits (the ones
+    that decide "< 1"), the rest with 4."""
+    dims = list(ds[columns[0]].dims)
+    flat = ds[columns].stack(point=dims) if dims else ds[columns].expand_dims(point=[0])
+    head = [d.split(".", 1)[-1] for d in dims] + [short.get(c, c) for c in columns]
+    rows = []
+    for i in range(flat.sizes["point"]):
+        row = [f"{float(flat[d].values[i]):.4g}" for d in dims]
+        for c in columns:
+            v = float(flat[c].values[i])
+            if c in flags:
+                row.append("yes" if v == 1 else "no")
+            else:
+                row.append(f"{v:.6g}" if c in precise else f"{v:.4g}")
+        rows.append(row)
+    width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(head, width))]
+    lines += ["  ".join(x.rjust(w) for x, w in zip(r, width)) for r in rows]
+    return "\n".join(lines)
+
+
+def summary(ds: xr.Dataset) -> str:
+    """Per grid point: fraction bounded, δ*, median β beside the predictions."""
+    cols = [c for c in ("fraction_bounded", "stability_radius", "beta_median",
+                        "beta_theory_discrete", "spectral_radius", "norm_condition",
+                        "beta_theorem5_proven", "beta_theorem5_printed") if c in ds]  # fmt: skip
+    short = {"fraction_bounded": "bounded", "stability_radius": "delta*", "beta_median":
+             "beta_med", "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
+             "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
+             "beta_theorem5_printed": "b5_printed"}  # fmt: skip
+    head = ("summary (bounded: fraction of members; delta*: stability radius; "
+            "beta_pred = -ln rho(R)/tau):")  # fmt: skip
+    return "\n" + head + "\n" + grid_table(ds, cols, short, flags=("norm_condition",)) + "\n"
