@@ -1,6 +1,6 @@
 """Throughput benchmark: member-steps per second for an ensemble of planar pendulums.
 
-Configuration (issue 3): planar pendulum, explicit midpoint rule (RK2, a = ½, σ = 1),
+Configuration: planar pendulum, explicit midpoint rule (RK2, a = ½, σ = 1),
 Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored every 0.05 s,
 10⁴ and 10⁵ members.  Measured side by side in one run, as ratios to the vectorized C:
 

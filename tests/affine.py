@@ -4,7 +4,7 @@
 
 with nonlinear forces.  The residual g = (f, ḟ, h) is then affine in (x, t), so one
 explicit Runge–Kutta step maps it exactly by the scheme's stability polynomial:
-g_{k+1} = R(τÃ) g_k, up to roundoff (issue 4: the discrete theory holds with equality).
+g_{k+1} = R(τÃ) g_k, up to roundoff (the discrete theory holds with equality).
 """
 
 from __future__ import annotations

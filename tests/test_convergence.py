@@ -68,7 +68,7 @@ def test_energy_conserved_to_order(name, scheme_name):
 
 
 def test_two_stage_first_order_when_2a_sigma_not_1():
-    """2aσ ≠ 1 warns and the measured order drops to one (DESIGN §5)."""
+    """2aσ ≠ 1 warns and the measured order drops to one (the paper's §5)."""
     with pytest.warns(UserWarning, match=r"2·a·σ = 1\.5 ≠ 1"):
         scheme = stabdae.two_stage(0.75, 1.0)
     assert scheme.order == 1
@@ -81,3 +81,35 @@ def test_two_stage_first_order_when_2a_sigma_not_1():
         for tau in taus
     ]  # fmt: skip
     assert abs(slope(taus, errors) - 1) <= 0.15
+
+
+@pytest.mark.parametrize("tau", [0.1, 0.02])
+def test_heun_step_is_heuns_map_of_the_right_hand_side(tau):
+    """One step of ``heun`` is Heun's method, x₁ = x₀ + τ/2 (k₁ + k₂) with
+    k₁ = F(t₀, x₀), k₂ = F(t₀ + τ, x₀ + τk₁), on a time-dependent model (F the stabilized
+    right-hand side, called directly).  Any other second-order two-stage scheme (Ralston's
+    a = 2/3, σ = 3/4, say) differs from it at order τ³."""
+    from stabdae._laws import bind_law
+    from stabdae.kernels.rhs import kernels_for
+
+    model = load_scene("pendulum_varying_length")
+    law = stabdae.baumgarte(5.0, 1.0)
+    bound = bind_law(law, model)
+    K = kernels_for(model, bound)
+    ws, p = K.make_workspace(), model.param_vector()
+
+    def F(t, x):
+        out = np.empty_like(x)
+        assert K.rhs(t, x, p, bound.matrix, bound.scalars, ws, out) == 0
+        return out
+
+    t0 = 0.3
+    x0 = model.reference_state() + 1e-3
+    ds = stabdae.integrate(model, x0, law, "heun", tau, t0 + tau, tau, t0=t0)
+    k1 = F(t0, x0)
+    k2 = F(t0 + tau, x0 + tau * k1)
+    np.testing.assert_allclose(ds.x.values[1], x0 + 0.5 * tau * (k1 + k2), rtol=4e-15,
+                               atol=1e-15)  # fmt: skip
+    k2r = F(t0 + 2 * tau / 3, x0 + 2 * tau / 3 * k1)
+    ralston = x0 + tau * (0.25 * k1 + 0.75 * k2r)
+    assert np.abs(ds.x.values[1] - ralston).max() > 1e3 * np.abs(ralston).max() * 1e-15

@@ -232,17 +232,23 @@ def test_scheme_errors():
 def test_integrate_errors():
     model = build()
     law = stabdae.baumgarte(10.0)
-    with pytest.raises(ValueError, match=r"t_end - t0 = 1 must be a whole multiple of tau = 0.3"):
+    with pytest.raises(
+        ValueError, match=r"^integrate: t_end - t0 = 1 must be a whole multiple of tau = 0.3"
+    ):
         stabdae.integrate(model, None, law, "rk4", 0.3, 1.0)
-    with pytest.raises(ValueError, match=r"save_dt = 0.15 must be a whole multiple of tau = 0.1"):
+    with pytest.raises(
+        ValueError, match=r"^integrate: save_dt = 0.15 must be a whole multiple of tau = 0.1"
+    ):
         stabdae.integrate(model, None, law, "rk4", 0.1, 1.0, 0.15)
-    with pytest.raises(ValueError, match=r"tau must be positive and finite, got -0.1"):
+    with pytest.raises(ValueError, match=r"^integrate: tau must be positive and finite, got -0.1"):
         stabdae.integrate(model, None, law, "rk4", -0.1, 1.0)
-    with pytest.raises(ValueError, match=r"x0 must have shape \(2n,\) = \(4,\) .*got \(2,\)"):
+    with pytest.raises(
+        ValueError, match=r"^integrate: x0 must have shape \(2n,\) = \(4,\) .*got \(2,\)"
+    ):
         stabdae.integrate(model, np.zeros(2), law, "rk4", 0.1, 1.0)
-    with pytest.raises(ValueError, match=r"x0 has non-finite entries"):
+    with pytest.raises(ValueError, match=r"^integrate: x0 has non-finite entries"):
         stabdae.integrate(model, np.full(4, np.nan), law, "rk4", 0.1, 1.0)
-    with pytest.raises(ValueError, match=r"give a law"):
+    with pytest.raises(ValueError, match=r"^integrate: give a law"):
         stabdae.integrate(model, None, None, "rk4", 0.1, 1.0)
-    with pytest.raises(ValueError, match=r"t_end must be after t0"):
+    with pytest.raises(ValueError, match=r"^integrate: t_end must be after t0"):
         stabdae.integrate(model, None, law, "rk4", 0.1, 0.0)

@@ -2,7 +2,7 @@
 
 References: the Test Set for IVP Solvers (Mazzia & Magherini, Bari), problems "andrews"
 (reference at t = 0.03 computed with PSIDE at tolerance 1e-14) and "caraxis" (t = 3);
-the residual law g(t) = expm(Ã t) g(0) (DESIGN §3); order conditions of the tableau.
+the residual law g(t) = expm(Ã t) g(0) (the paper's §3); order conditions of the tableau.
 """
 
 from __future__ import annotations
@@ -240,3 +240,45 @@ def test_double_pendulum_over_a_million_steps():
     assert np.max(np.abs(e - e[0])) < 1e-6 * max(1.0, abs(e[0]))
     free = stabdae.integrate(model, None, stabdae.none(), "rk4", 1e-3, 1000.0, 10.0)
     assert free.residual_norm.values[-1] > 100 * ds.residual_norm.max()
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-9])
+def test_adaptive_loop_takes_scipy_rk45s_steps(rtol):
+    """The Dormand–Prince loop is SciPy's ``RK45`` step for step (the same RMS error norm,
+    step factor, no growth after a rejection, first-step choice): on the stabilized
+    pendulum both take the same number of accepted steps and right-hand-side evaluations,
+    and end at the same state to roundoff."""
+    from scipy.integrate import solve_ivp
+
+    from stabdae._laws import bind_law
+    from stabdae.kernels.rhs import kernels_for
+
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    bound = bind_law(law, model)
+    K = kernels_for(model, bound)
+    ws, p = K.make_workspace(), model.param_vector()
+
+    def F(t, x):
+        out = np.empty_like(x)
+        assert K.rhs(t, x, p, bound.matrix, bound.scalars, ws, out) == 0
+        return out
+
+    x0 = model.reference_state() + 1e-3
+    ref = solve_ivp(F, (0.0, 10.0), x0, method="RK45", rtol=rtol, atol=rtol)
+    ds = stabdae.integrate_adaptive(model, x0, law, 10.0, rtol=rtol, atol=rtol)
+    assert ds.attrs["steps_accepted"] == len(ref.t) - 1
+    assert ds.attrs["rhs_evaluations"] == ref.nfev
+    np.testing.assert_allclose(ds.x.values[-1], ref.y[:, -1], rtol=1e-12, atol=1e-13)
+
+
+def test_adaptive_samples_end_exactly_at_t_end():
+    """Sample times every save_dt with the last one at t_end exactly, also where
+    3 × 0.3 falls short of 0.9 in floating point; the ensemble's likewise."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    ds = stabdae.integrate_adaptive(model, None, law, 0.9, rtol=1e-8, save_dt=0.3)
+    assert ds.time.values.tolist() == [0.0, 0.3, 0.6, 0.9]
+    ens = stabdae.ensemble(model, law, tau=1e-3, t_end=0.9, rtol=1e-8, members=2,
+                           save_dt=0.3)  # fmt: skip
+    assert ens.time.values[-1] == 0.9

@@ -47,6 +47,7 @@ def test_netcdf_round_trip(tmp_path):
     assert sorted(p.name for p in path.parent.iterdir()) == ["sleigh.nc"]  # no temporary left
     with xr.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), ds)
+        assert back.x.encoding.get("zlib") is True and back.residual.encoding.get("zlib") is True
     with pytest.raises(FileExistsError, match="exists"):
         write_netcdf(ds, path, overwrite=False)
 
@@ -62,8 +63,8 @@ def test_params_change_without_recompiling():
                           stabdae.baumgarte(3.0, 0.5), "euler", 1e-3, 0.5, 0.5,
                           params={"l": 2.0})  # fmt: skip
     assert len(kernel.signatures) == before
-    # a longer pendulum swings more slowly: the states differ
-    assert not np.allclose(a.x.values[-1], b.x.values[-1])
+    # each run stays on the circle of its own length: the parameter reached the kernel
+    assert abs(np.hypot(*a.x.values[-1, :2]) - 1.0) < 1e-6
     assert abs(np.hypot(*b.x.values[-1, :2]) - 2.0) < 1e-3
 
 
@@ -138,7 +139,7 @@ def test_blow_up_stops_with_a_status_and_keeps_the_finite_part():
     x0 = perturbed_state(model, 1e-3)
     with pytest.warns(stabdae.IntegrationWarning, match=r"stopped at step \d+"):
         ds = stabdae.integrate(model, x0, stabdae.baumgarte(100.0), "euler", 0.1, 100.0)
-    assert ds.attrs["status"] in (stabdae.Status.NONFINITE_STATE, stabdae.Status.SINGULAR_S)
+    assert ds.attrs["status"] == stabdae.Status.NONFINITE_STATE  # it overflows
     done = ds.attrs["steps_completed"]
     assert 0 < done < 1000
     assert np.isfinite(ds.x.values[: done + 1]).all() and np.isnan(ds.x.values[done + 1 :]).all()

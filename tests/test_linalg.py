@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stabdae._linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
+from stabdae.kernels.linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5, 8])
@@ -48,7 +48,7 @@ def test_singular_indefinite_and_nan_are_reported():
 @pytest.mark.parametrize("n,rank", [(1, 1), (3, 3), (4, 3), (5, 2), (6, 6)])
 def test_pinv_solve_sym_matches_numpy_pinv(n, rank):
     """The least-squares multiplier: S⁺b against numpy.linalg.pinv, full and deficient rank."""
-    from stabdae._linalg import pinv_solve_sym
+    from stabdae.kernels.linalg import pinv_solve_sym
 
     rng = np.random.default_rng(n + rank)
     F = rng.standard_normal((n, rank)) @ rng.standard_normal((rank, n))
@@ -65,7 +65,7 @@ def test_fma_rounds_once_where_the_host_has_fma():
     1 + 2⁻²⁹ and gives 0.  Without FMA hardware ``fma`` is that multiply-then-add."""
     from numba import njit
 
-    from stabdae._fma import HOST_FMA, fma
+    from stabdae.kernels.fma import HOST_FMA, fma
 
     @njit
     def f(a, b, c):
@@ -74,3 +74,18 @@ def test_fma_rounds_once_where_the_host_has_fma():
     a = 1.0 + 2.0**-30
     assert f(a, a, -(1.0 + 2.0**-29)) == (2.0**-60 if HOST_FMA else 0.0)
     assert f(3, 2.0, 1.0) == 7.0  # integers are converted
+
+
+@pytest.mark.parametrize("scale", [1e-20, 1.0, 1e20])
+def test_pivot_rule_is_relative_to_the_matrix_scale(scale):
+    """The pivot test is relative to the largest diagonal entry, so a badly scaled matrix
+    is judged as its unscaled self: a well-conditioned SPD matrix factors at any scale
+    (an absolute 1e-12 would call it singular at 1e-20), and one singular to working
+    precision is reported at any scale (an absolute threshold would pass it at 1e20)."""
+    good = scale * np.array([[4.0, 1.0], [1.0, 3.0]])
+    buf = good.copy()
+    assert ldl_inplace(buf, 2, 1e-12) == 0
+    L = np.array([[1.0, 0.0], [buf[1, 0], 1.0]])
+    np.testing.assert_allclose(L @ np.diag(1.0 / np.diag(buf)) @ L.T, good, rtol=1e-14)
+    near = scale * np.array([[1.0, 1.0], [1.0, 1.0 + 1e-14]])
+    assert ldl_inplace(near.copy(), 2, 1e-12) == 2

@@ -1,6 +1,6 @@
 """The exact residual law: along the exact flow of (3.1), g(t) = expm(Ã t) g(t0).
 
-DESIGN §3: by construction of the multiplier (3.11) every model's residual obeys ġ = Ã g,
+The paper's §3: by construction of the multiplier (3.11) every model's residual obeys ġ = Ã g,
 whatever its mechanics.  Integrating with RK4 at a small step and comparing g(t) with the
 matrix exponential checks every derivative function of every scene and the right-hand
 side itself; a wrong f_accel, h_q or sign in (3.11) breaks it at order one.

@@ -3,6 +3,7 @@ pictures."""
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -78,6 +79,8 @@ def test_run_writes_dataset_and_pictures_and_refuses_to_overwrite(tmp_path, caps
     assert ds.residual_norm.dims == ("tau", "omega", "member", "time")
     assert_schema(ds)
     assert "stabdae run study.toml: 12 grid points of 64 members" in ds.attrs["history"]
+    assert ds.attrs["study"] == "study.toml" and ds.attrs["swept"] == "run.tau, law.omega"
+    assert ds.residual_norm.encoding.get("zlib") is True  # written compressed
     # τ = 0.1, 0.2 are larger than save_dt: samples between their steps are NaN
     r = ds.residual_norm.sel(tau=0.2, omega=5.0).values
     assert np.isfinite(r[:, ::4]).all() and np.isnan(r[:, 1::4]).all()
@@ -121,6 +124,26 @@ def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
     assert not parts.exists()
     same_data(xr.open_dataset(tmp_path / "out" / "study.nc").load(),
               xr.open_dataset(reference).load())  # fmt: skip
+
+
+def test_run_refuses_the_parts_of_another_study(tmp_path):
+    """A parts folder left by a run of another study (or other ensemble settings) under
+    the same output is refused, not mixed in; --force discards it and starts over."""
+    from stabdae.study.run import _fingerprint
+    from stabdae.study.spec import load_study
+
+    mine = study_file(tmp_path, omegas="5.0", name="mine.toml")
+    other = study_file(tmp_path, omegas="5.0, 30.0", name="other.toml")
+    parts = tmp_path / "out" / "study.nc.parts"
+    parts.mkdir(parents=True)
+    (parts / "study.json").write_text(json.dumps(
+        {"fingerprint": _fingerprint(load_study(other)), "study": str(other)}))
+    (parts / "point-0.nc").write_bytes(b"not this study's")
+    with pytest.raises(FileExistsError, match="holds a run of a different study"):
+        run_study(mine, progress=False, log=lambda *a: None)
+    assert (parts / "point-0.nc").exists()
+    out = run_study(mine, force=True, progress=False, log=lambda *a: None)
+    assert out.exists() and not parts.exists()
 
 
 def test_default_run_starts_no_cluster(tmp_path):

@@ -1,5 +1,5 @@
 """The other stabilizations of the toolkit: Ascher–Chin–Petzold–Reich (ACPR), post-
-stabilization and coordinate projection (DESIGN §3, end).
+stabilization and coordinate projection (the end of the paper's §3).
 
 References: on the affine system of tests/affine.py the ACPR residual obeys a linear law
 whose matrix is derived by hand below, so one RK step maps g by the scheme's stability
@@ -95,6 +95,22 @@ def test_projection_lands_on_the_pendulum_circle_radially():
     f0 = abs(x[0] ** 2 + x[1] ** 2 - length**2)
     f1 = abs(y[0] ** 2 + y[1] ** 2 - length**2)
     assert 0 < f1 < 0.2 * f0
+
+
+def test_projection_full_goes_to_the_fixed_point():
+    """integrate(projection="full") from a state far off the pendulum's circle: after one
+    (negligible) step the state is the projection's fixed point, the closest point of the
+    circle and the tangential velocity (closed forms), not one sweep's approximation."""
+    model = load_scene("pendulum")
+    length = model.default_params()[list(model.param_names).index("l")]
+    x = np.array([0.9 * length, -0.5 * length, 0.3, 0.7])
+    ds = stabdae.integrate(model, x, stabdae.none(), "euler", 1e-13, 1e-13,
+                           projection="full")  # fmt: skip
+    q = x[:2] * length / np.linalg.norm(x[:2])
+    u = q / np.linalg.norm(q)
+    np.testing.assert_allclose(ds.x.values[1, :2], q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ds.x.values[1, 2:], x[2:] - (x[2:] @ u) * u, rtol=0, atol=1e-12)
+    assert float(ds.residual_norm[1]) < 1e-14
 
 
 @pytest.mark.parametrize("name", ["double_pendulum", "affine", "chaplygin_sleigh"])

@@ -1,7 +1,7 @@
 """stabdae.symbolic: models generated from a sympy Lagrangian.
 
 References: the hand-written scenes (every function, at random states, to 1e-12), the exact
-residual law g(t) = expm(Ã t) g(0) (DESIGN §3) for a system with no hand-written scene,
+residual law g(t) = expm(Ã t) g(0) (the paper's §3) for a system with no hand-written scene,
 and the conical spherical pendulum's closed-form motion.
 """
 

@@ -24,9 +24,8 @@ def test_scalar_law_limits(k):
     for scheme in ("euler", "midpoint", "heun"):
         for cond in theory.CONDITIONS:  # all norms coincide for a scalar
             assert theory.tau_limit(A, scheme, cond) == pytest.approx(2.0 / k, rel=1e-9)
-    # RK4's real stability interval: the positive root of z³ − 4z² + 12z − 24 = 0
-    z4 = max(r.real for r in np.roots([1, -4, 12, -24]) if abs(r.imag) < 1e-12)
-    assert z4 == pytest.approx(2.785293563405282, rel=1e-12)
+    # RK4's real stability interval ends at −z4, the real root of z³ − 4z² + 12z − 24
+    z4 = 2.785293563405282
     assert theory.tau_limit(A, "rk4") == pytest.approx(z4 / k, rel=1e-9)
     d = theory.discrete(A, "euler", 0.5 / k)
     assert d.spectral_radius == pytest.approx(0.5) and d.norm_max == pytest.approx(0.5)
@@ -92,14 +91,12 @@ def test_weighted_norm_condition_holds_exactly_when_spectral_radius_below_one():
 def test_lyapunov_uses_the_symmetric_part():
     # −LÃ has positive leading minors (the paper's test passes) but its symmetric part is
     # indefinite: V grows along α = (1, 1), so the theorem must not be claimed.
+    # (leading minors of −LÃ: 1 and 1; αᵀLÃα = 8 > 0 at α = (1, 1))
     A = np.array([[-1.0, 10.0], [0.0, -1.0]])
     L = np.eye(2)
-    minors_paper = [np.linalg.det((-L @ A)[:i, :i]) for i in (1, 2)]
-    assert all(m > 0 for m in minors_paper)
     out = theory.lyapunov(A, L)
     assert not out["holds"]
-    alpha = np.array([1.0, 1.0])
-    assert alpha @ L @ (A @ alpha) > 0  # V̇ > 0
+    assert out["minors_Q"][1] < 0  # the symmetric part −(LÃ + ÃᵀL)/2 = [[1, −5], [−5, 1]]
     # with L from the Lyapunov equation the same Ã is proven stable
     out = theory.lyapunov(A)
     assert out["holds"] and out["beta"] > 0
@@ -173,6 +170,51 @@ def test_theorem5_printed_bound_fails_where_proven_bound_holds():
     assert float(ds.beta_median) == pytest.approx(1.0, rel=0.02)
 
 
+def test_theorem5_constants_and_law_with_two_constraints_and_L_not_identity():
+    """Two nonholonomic constraints, W = diag(9, 4), L with eigenvalues 1/2 and 2: Theorem
+    5's rates in closed form (proven k·λ_min(W)·l₁²/l_m = k/2, printed k·w₀·l₁²/l_m = k/4),
+    and the residual following ḣ = −k W L h, i.e. expm(−k W L t) h(0)."""
+    from linear_nonholonomic import W
+    from linear_nonholonomic import model as lin
+    from scipy.linalg import expm
+
+    c, s = math.cos(0.4), math.sin(0.4)
+    Q = np.array([[c, -s], [s, c]])
+    L = Q @ np.diag([0.5, 2.0]) @ Q.T
+    k = 3.0
+    law = stabdae.theorem5(k, L)
+    c5 = theory.theorem5(lin, law, lin.reference_state()[None, :])
+    assert c5["lambda_min_W"] == pytest.approx(4.0, rel=1e-14)
+    assert (c5["l1"], c5["lm"]) == (pytest.approx(0.5, rel=1e-14), pytest.approx(2.0, rel=1e-14))
+    assert c5["beta_proven"] == pytest.approx(k * 4.0 * 0.25 / 2.0, rel=1e-13)
+    assert c5["beta_printed"] == pytest.approx(k * 2.0 * 0.25 / 2.0, rel=1e-13)
+    assert c5["gamma_factor"] == pytest.approx(2.0, rel=1e-14)
+    x0 = lin.reference_state() + np.array([0, 0, 0, 0.01, -0.02, 0.0])
+    ds = stabdae.integrate(lin, x0, law, "rk4", 5e-4, 1.0, 0.1)
+    h0 = ds.residual.values[0]
+    for i in (3, 10):
+        t = float(ds.time[i])
+        np.testing.assert_allclose(ds.residual.values[i], expm(-k * W @ L * t) @ h0,
+                                   rtol=1e-9, atol=1e-15)  # fmt: skip
+
+
+@pytest.mark.parametrize("scheme", ["euler", "midpoint", "heun", "rk4"])
+def test_tau_limit_lies_just_on_the_stable_side_of_the_exact_limit(scheme):
+    """Scalar law ġ = −k g: the spectral limit is z*/k with z* the real stability boundary
+    (2 for Euler and second-order two-stage schemes, the positive root of
+    z³ − 4z² + 12z − 24 for RK4).  The answer is within rtol below it, never above (where
+    ρ ≥ 1), and ``inf`` when the condition holds up to ``tau_max``."""
+    k = 3.0
+    A = np.array([[-k]])
+    z = 2.785293563405282 if scheme == "rk4" else 2.0
+    exact = z / k
+    lim = theory.tau_limit(A, scheme, rtol=1e-10)
+    assert exact * (1 - 2e-10) <= lim < exact
+    assert theory.spectral_radius(theory.step_matrix(A, scheme, lim)) < 1.0
+    assert theory.spectral_radius(theory.step_matrix(A, scheme, exact * (1 + 1e-9))) > 1.0
+    assert theory.tau_limit(A, scheme, tau_max=0.5 * exact) == math.inf
+
+
 @pytest.mark.parametrize("scene", ["pendulum", "double_pendulum"])
 def test_tau_sweep_boundary_matches_the_spectral_radius(scene):
     """Sweeping τ: every member stays bounded wherever the weighted-norm condition holds,
@@ -242,4 +284,4 @@ def test_predictions_memo_gives_the_computed_values_per_tau_and_law():
     other_law = theory.predictions(model, stabdae.baumgarte(10.0, 1.0), scheme, 0.05)
     assert other_tau["spectral_radius"] != again["spectral_radius"]
     assert other_law["spectral_radius"] != again["spectral_radius"]
-    assert len(theory._PREDICTIONS) == 3
+    assert theory.predictions(model, law, scheme, 0.02) == other_tau  # the entries stay apart

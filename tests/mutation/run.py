@@ -1,0 +1,111 @@
+"""Apply single-point changes to a copy of the repository and see which the tests catch.
+
+Usage: ``python tests/mutation/run.py [--jobs N] [--list] [NAME ...]`` (see README.md).
+Each mutant of :data:`mutants.MUTANTS` replaces one exact snippet (it must occur exactly
+once in its file) in a fresh copy of the tracked and untracked files, then runs its test
+selection with ``pytest -x`` against that copy (its own kernel cache, so that nothing
+compiled from the real source is reused).  A mutant is *caught* when a test fails.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from mutants import MUTANTS  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _copy_tree(dest: Path) -> None:
+    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=ROOT,
+                           capture_output=True, text=True, check=True).stdout.split()  # fmt: skip
+    for rel in files:
+        src = ROOT / rel
+        if src.is_file():
+            (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dest / rel)
+
+
+def run_mutant(m, timeout: float) -> dict:
+    """Apply ``m`` in a temporary copy, run its tests; the outcome as a dict."""
+    with tempfile.TemporaryDirectory(prefix=f"mutant-{m.name}-") as tmp:
+        tmp = Path(tmp)
+        _copy_tree(tmp)
+        path = tmp / m.file
+        text = path.read_text()
+        count = text.count(m.old)
+        if count != 1:
+            return {"name": m.name, "outcome": f"NOT APPLIED ({count} matches)", "test": "",
+                    "seconds": 0.0}  # fmt: skip
+        path.write_text(text.replace(m.old, m.new))
+        env = dict(os.environ, PYTHONPATH=str(tmp / "src"),
+                   STABDAE_CACHE_DIR=str(tmp / ".cache"), PYTHONDONTWRITEBYTECODE="1")
+        cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+               "-W", "ignore", *m.tests]  # fmt: skip
+        if m.select:
+            cmd += ["-k", m.select]
+        start = time.perf_counter()
+        try:
+            proc = subprocess.run(cmd, cwd=tmp, env=env, capture_output=True, text=True,
+                                  timeout=timeout)  # fmt: skip
+            out, code = proc.stdout + proc.stderr, proc.returncode
+        except subprocess.TimeoutExpired:
+            out, code = "", "timeout"
+        seconds = time.perf_counter() - start
+    failed = re.findall(r"^FAILED (\S+)", out, re.M) or re.findall(r"^ERROR (\S+)", out, re.M)
+    if code == 0:
+        outcome, test = "SURVIVED", ""
+    elif code == "timeout":
+        outcome, test = "timeout", ""
+    elif failed:
+        outcome, test = "caught", failed[0]
+    elif code < 0 or "Fatal Python error" in out or "Segmentation fault" in out:
+        outcome, test = "caught (crash)", f"signal {-code}" if code < 0 else "crash"
+    else:
+        outcome, test = f"caught (exit {code})", out.strip().splitlines()[-1] if out else ""
+    return {"name": m.name, "outcome": outcome, "test": test, "seconds": seconds}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("names", nargs="*", help="mutants to run (default: all)")
+    ap.add_argument("--jobs", type=int, default=2, help="mutants run at once (default 2)")
+    ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per mutant")
+    ap.add_argument("--list", action="store_true", help="list the mutants and exit")
+    args = ap.parse_args(argv)
+    chosen = [m for m in MUTANTS if not args.names or m.name in args.names]
+    unknown = set(args.names) - {m.name for m in MUTANTS}
+    if unknown:
+        ap.error(f"unknown mutants: {', '.join(sorted(unknown))}")
+    if args.list:
+        for m in chosen:
+            print(f"{m.name:32s} {m.file}: {m.what}")
+        return 0
+    print(f"{len(chosen)} mutants, {args.jobs} at a time", flush=True)
+    start = time.perf_counter()
+    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        results = list(pool.map(lambda m: run_mutant(m, args.timeout), chosen))
+    width = max(len(m.name) for m in chosen)
+    print(f"\n| {'mutant':{width}s} | place | change | outcome | caught by | s |")
+    print(f"|{'-' * (width + 2)}|---|---|---|---|---|")
+    for m, r in zip(chosen, results):
+        print(f"| {m.name:{width}s} | `{m.file.removeprefix('src/')}` | {m.what} | "
+              f"{r['outcome']} | {r['test']} | {r['seconds']:.0f} |")  # fmt: skip
+    survived = [r["name"] for r in results if not r["outcome"].startswith("caught")]
+    print(f"\n{len(results) - len(survived)} of {len(results)} caught in "
+          f"{time.perf_counter() - start:.0f} s; survivors: {', '.join(survived) or 'none'}")
+    return 1 if survived else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
