@@ -129,3 +129,31 @@ def test_user_law_state_dependent_obeys_gdot():
     predicted = np.stack([law.A_tilde(model, x) @ gi for x, gi in zip(xs[1:-1], g[1:-1])])
     scale = np.max(np.abs(predicted))
     assert np.max(np.abs(gdot - predicted)) <= 1e-4 * scale
+
+
+@pytest.mark.parametrize("xi", [0.5, 1.0])
+def test_baumgarte_residual_is_the_damped_oscillator(xi):
+    """Baumgarte's law is f̈ + 2ξω ḟ + ω² f = 0 for each holonomic constraint: the
+    pendulum's residual follows the damped oscillator's closed form,
+    f(t) = e^{−ξωt}(f₀ cos ω_d t + (ḟ₀ + ξω f₀) sin(ω_d t)/ω_d), ω_d = ω√(1 − ξ²)
+    (and (f₀ + (ḟ₀ + ω f₀) t) e^{−ωt} at ξ = 1), and ḟ its derivative."""
+    model = load_scene("pendulum")
+    omega = 10.0
+    ds = stabdae.integrate(model, perturbed_state(model, 1e-3), stabdae.baumgarte(omega, xi),
+                           "rk4", 5e-4, 0.5, 0.05)  # fmt: skip
+    f0, fd0 = ds.residual.values[0]
+    t = ds.time.values
+    decay = np.exp(-xi * omega * t)
+    if xi < 1:
+        wd = omega * np.sqrt(1 - xi**2)
+        c, s = np.cos(wd * t), np.sin(wd * t)
+        b = (fd0 + xi * omega * f0) / wd
+        f = decay * (f0 * c + b * s)
+        fd = decay * (-xi * omega * (f0 * c + b * s) + wd * (-f0 * s + b * c))
+    else:
+        b = fd0 + omega * f0
+        f = decay * (f0 + b * t)
+        fd = decay * (b - omega * (f0 + b * t))
+    scale = np.abs(ds.residual.values[0]).max()
+    np.testing.assert_allclose(ds.residual.values[:, 0], f, rtol=0, atol=1e-8 * scale)
+    np.testing.assert_allclose(ds.residual.values[:, 1], fd, rtol=0, atol=1e-7 * scale)

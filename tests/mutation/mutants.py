@@ -105,7 +105,7 @@ MUTANTS = [
     Mutant("baumgarte-damping", S + "_laws.py",
            "A[:m, m : 2 * m] = -2.0 * self.xi * self.omega * np.eye(m)",
            "A[:m, m : 2 * m] = -self.xi * self.omega * np.eye(m)",
-           ("tests/test_residual_law.py",), "Baumgarte's damping 2ξω → ξω"),
+           ("tests/test_residual_law.py",), "Baumgarte's damping 2ξω → ξω", "oscillator"),
     Mutant("two-stage-matrix", S + "theory.py",
            "return E + tau * A + 0.5 * tau * tau * (A @ A + Ad)",
            "return E + tau * A + tau * tau * (A @ A + Ad)", ("tests/test_theory.py",),
@@ -121,6 +121,6 @@ MUTANTS = [
            "the floor is the median of the whole trace, not its last fifth",
            "beta or decay or floor"),
     Mutant("growth-after-reject", K + "adaptive.py", "                    fac = min(fac, 1.0)\n",
-           "", ("tests/test_hard_cases.py",),
+           "                    fac = fac\n", ("tests/test_hard_cases.py",),
            "the step grows right after a rejection", "scipy"),
 ]
