@@ -299,8 +299,10 @@ def test_time_dependent_model_every_tableau_pattern_equals_single_integrations(s
     stage times t + c·τ matter: the ensemble kernel's generated step gives the numbers of
     ``integrate`` bit for bit for every pattern of coefficients."""
     scheme = _scheme(spec)
-    for name, law, tau in (("pendulum_varying_length", stabdae.baumgarte(10.0, 1.0), 2e-3),
-                           ("car_axis", stabdae.baumgarte(50.0, 1.0), 1e-3)):  # fmt: skip
+    cases = [("pendulum_varying_length", stabdae.baumgarte(10.0, 1.0), 2e-3)]
+    if spec == "rk4":  # (one pattern on the car axis: each pattern is a compilation)
+        cases.append(("car_axis", stabdae.baumgarte(50.0, 1.0), 1e-3))
+    for name, law, tau in cases:
         model = load_scene(name)
         ds = stabdae.ensemble(model, law, scheme, tau, 0.1, members=3, seed=5,
                               radius=(1e-6, 1e-4), save_dt=0.02)  # fmt: skip

@@ -174,3 +174,39 @@ def test_dask_cluster_gives_the_same_dataset(tmp_path):
     local = run_study(path, tmp_path / "local.nc", progress=False, log=lambda *a: None)
     dist = run_study(path, tmp_path / "dask.nc", workers=2, progress=False, log=lambda *a: None)
     same_data(xr.open_dataset(dist).load(), xr.open_dataset(local).load())
+
+
+def test_separate_scheduler_and_worker_processes_give_the_same_dataset(tmp_path):
+    """--scheduler ADDRESS: a dask scheduler and a worker started as their own processes
+    (on the loopback interface, in another folder), as on a cluster; the dataset equals the
+    in-process run's."""
+    pytest.importorskip("distributed")
+    path = study_file(tmp_path, omegas="5.0, 30.0")
+    local = run_study(path, tmp_path / "local.nc", progress=False, log=lambda *a: None)
+    elsewhere = tmp_path / "worker_dir"
+    elsewhere.mkdir()
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+    scheduler_file = tmp_path / "scheduler.json"
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler",
+                               "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                               "--scheduler-file", str(scheduler_file)],
+                              cwd=elsewhere, env=env, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)]  # fmt: skip
+    try:
+        deadline = time.time() + 60
+        while not scheduler_file.exists() and time.time() < deadline:
+            time.sleep(0.1)
+        address = json.loads(scheduler_file.read_text())["address"]
+        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker",
+                                       address, "--nworkers", "1", "--nthreads", "1",
+                                       "--no-dashboard", "--host", "127.0.0.1"],
+                                      cwd=elsewhere, env=env, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.DEVNULL))  # fmt: skip
+        remote = run_study(path, tmp_path / "remote.nc", scheduler=address, progress=False,
+                           log=lambda *a: None)  # fmt: skip
+    finally:
+        for proc in reversed(procs):
+            proc.terminate()
+        for proc in procs:
+            proc.wait(timeout=60)
+    same_data(xr.open_dataset(remote).load(), xr.open_dataset(local).load())
