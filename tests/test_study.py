@@ -153,11 +153,10 @@ def test_theory_command_prints_the_table(tmp_path, capsys):
     rows = [line.split() for line in out.splitlines() if line.strip().startswith(("0.01", "0.05"))]
     assert len(rows) == 2 and all(r[4] == "yes" for r in rows)
     # the numbers behind the table: midpoint at critical damping, τ limit exactly 2/ω
-    # (to 1e-7: the eigenvalues of the Jordan block R(τÃ) carry √ε errors)
     from stabdae.study.theory import for_study
 
     ds = for_study(load_study(path))
-    assert ds.tau_limit_spectral.values == pytest.approx([0.2, 0.2], rel=1e-7)
+    assert ds.tau_limit_spectral.values == pytest.approx([0.2, 0.2], rel=1e-9)
     assert (ds.tau_limit_spectral.values < 0.2).all()
     assert (ds.tau_limit_max_norm.values == 0).all() and (ds.tau_limit_two_norm.values == 0).all()
 

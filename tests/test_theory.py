@@ -285,3 +285,55 @@ def test_predictions_memo_gives_the_computed_values_per_tau_and_law():
     assert other_tau["spectral_radius"] != again["spectral_radius"]
     assert other_law["spectral_radius"] != again["spectral_radius"]
     assert theory.predictions(model, law, scheme, 0.02) == other_tau  # the entries stay apart
+
+
+def _exact_spectral_limit(omega, xi, coeffs):
+    """The spectral τ limit of Baumgarte's 2×2 block from its analytic eigenvalues
+    ω(−ξ ± √(ξ² − 1)), to 40 digits: the smallest positive root of |R(τλ)|² − 1
+    (mpmath, independent of the library's eigenvalue computation)."""
+    import mpmath as mp
+
+    mp.mp.dps = 40
+    best = mp.inf
+    root = mp.sqrt(mp.mpf(xi) ** 2 - 1)
+    for lam in (omega * (-mp.mpf(xi) + root), omega * (-mp.mpf(xi) - root)):
+        a = [mp.mpf(c) * lam**k for k, c in enumerate(coeffs)]
+        b = [mp.mpf(0)] * (2 * len(a) - 1)
+        for j, aj in enumerate(a):
+            for k, ak in enumerate(a):
+                b[j + k] += mp.re(aj * mp.conj(ak))
+        b[0] -= 1
+        nonzero = [i for i, v in enumerate(b) if abs(v) > mp.mpf(10) ** -30]
+        low, high = nonzero[0], nonzero[-1]
+        if b[low] > 0:
+            return 0.0
+        roots = mp.polyroots(b[low : high + 1][::-1], maxsteps=200, extraprec=200)
+        pos = [mp.re(r) for r in roots if abs(mp.im(r)) < 1e-25 and mp.re(r) > 0]
+        if pos:
+            best = min(best, min(pos))
+    return float(best)
+
+
+@pytest.mark.parametrize("xi", [0.0, 1e-9, 0.25, 0.5, 1 / math.sqrt(2), 1.0, 2.0])
+@pytest.mark.parametrize("scheme", ["euler", "midpoint", "heun", "rk4", "dopri5"])
+def test_spectral_tau_limit_exact_for_every_damping(scheme, xi):
+    """τ limits against the exact limits of the damped oscillator for undamped, nearly
+    undamped, under-, critically and over-damped Baumgarte laws (RK4's 2√2/ω at ξ = 0,
+    none for Euler and the two-stage schemes there), to the rtol asked; ρ(R(τÃ)) exact at
+    the Jordan block of ξ = 1.  (ω = 7.3: its critically damped Ã has eigenvalues that
+    LAPACK returns spread by 1.6e-8 relative, where ω = 10's come out exact.)"""
+    omega = 7.3
+    A = baumgarte_At(omega, xi)
+    coeffs = stabdae.theory.as_scheme(scheme).stability_polynomial()
+    exact = _exact_spectral_limit(omega, xi, coeffs)
+    got = theory.tau_limit(A, scheme, rtol=1e-10)
+    if exact == 0.0:
+        assert got == 0.0
+    else:
+        assert exact * (1 - 2e-10) <= got < exact, (got, exact)
+        assert theory.tau_limit(A, scheme, "weighted_norm", rtol=1e-10) == got
+    if scheme == "rk4" and xi == 0.0:
+        assert got == pytest.approx(2 * math.sqrt(2) / omega, rel=1e-9)
+    if xi == 1.0:  # R(τÃ) for Euler at τω = 0.1: a Jordan block of eigenvalue 0.9
+        rho = theory.discrete(A, "euler", 0.1 / omega, limits=False).spectral_radius
+        assert rho == pytest.approx(0.9, rel=1e-14)

@@ -54,6 +54,8 @@ __all__ = [
     "lyapunov",
     "step_matrix",
     "spectral_radius",
+    "spectral_radius_of",
+    "eigenvalues",
     "weighted_norm",
     "discrete",
     "tau_limit",
@@ -140,7 +142,69 @@ def step_matrix(A_tilde, scheme, tau: float, A_dot=None) -> np.ndarray:
 
 
 def spectral_radius(R) -> float:
+    """``max |λ(R)|`` of a matrix (for ``R(τÃ)`` of a constant law
+    :func:`spectral_radius_of` is exact where this loses digits to a defective
+    eigenvalue)."""
     return float(np.max(np.abs(np.linalg.eigvals(R))))
+
+
+#: computed eigenvalues closer than this (relative to the largest) are one multiple
+#: eigenvalue: a defective one comes out spread by about √ε, far above roundoff
+_CLUSTER_RTOL = 1e-6
+
+
+def eigenvalues(A_tilde) -> np.ndarray:
+    """Eigenvalues of ``Ã`` with every cluster of a multiple eigenvalue replaced by its
+    mean.  A defective eigenvalue (critically damped Baumgarte: a Jordan block) is computed
+    with errors of order √ε; the mean of its cluster, the trace of its invariant subspace
+    over the multiplicity, is accurate to roundoff."""
+    A = _square(A_tilde, "eigenvalues")
+    lam = np.linalg.eigvals(A).astype(complex)
+    if lam.size == 0:
+        return lam
+    tol = _CLUSTER_RTOL * max(float(np.abs(lam).max()), np.finfo(float).tiny)
+    out = lam.copy()
+    done = np.zeros(lam.size, dtype=bool)
+    for i in range(lam.size):
+        if done[i]:
+            continue
+        members = (~done) & (np.abs(lam - lam[i]) <= tol)
+        out[members] = lam[members].mean()
+        done |= members
+    return out
+
+
+def spectral_radius_of(A_tilde, scheme, tau: float) -> float:
+    """``ρ(R(τÃ))`` of a constant law from the eigenvalues of ``Ã``: ``max |R(τλ)|`` with
+    ``R`` the scheme's stability polynomial (the spectral mapping theorem)."""
+    coeffs = as_scheme(scheme).stability_polynomial()
+    z = tau * eigenvalues(A_tilde)
+    return float(np.abs(np.polynomial.polynomial.polyval(z, coeffs)).max())
+
+
+def _spectral_limit(A, scheme, tau_max: float) -> float:
+    """The largest τ with ``|R(τλ)| < 1`` on ``(0, τ)`` for every eigenvalue λ of ``Ã``:
+    the smallest positive root of the real polynomial ``|R(τλ)|² − 1`` in τ (0 when it is
+    positive just after τ = 0, ``inf`` when it has no root up to ``tau_max``)."""
+    c = as_scheme(scheme).stability_polynomial()
+    best = math.inf
+    for lam in eigenvalues(A):
+        a = c * lam ** np.arange(c.size)  # R(τλ) = Σ a_k τ^k
+        b = np.convolve(a, np.conj(a)).real  # |R(τλ)|² = Σ b_n τ^n
+        size = np.convolve(np.abs(a), np.abs(a))  # the terms' magnitude, for roundoff
+        b[0] -= 1.0  # (= 0: R(0) = 1)
+        b[np.abs(b) <= 64 * np.finfo(float).eps * size] = 0.0
+        nz = np.flatnonzero(b)
+        if nz.size == 0:  # |R| ≡ 1 (λ = 0): never below 1
+            return 0.0
+        low = nz[0]
+        if b[low] > 0:  # above 1 right after τ = 0
+            return 0.0
+        roots = np.roots(b[low:][::-1])  # b_low + b_{low+1} τ + … with τ^low divided out
+        real = roots[(np.abs(roots.imag) <= 1e-9 * np.abs(roots)) & (roots.real > 0)].real
+        if real.size:
+            best = min(best, float(real.min()))
+    return math.inf if best > tau_max else best
 
 
 def lyapunov_weight(R):
@@ -198,6 +262,14 @@ def tau_limit(A_tilde, scheme, condition: str = "spectral", *, tau_max: float | 
     lam = np.abs(np.linalg.eigvals(A)).max()
     scale = 1.0 / lam if lam > 0 else 1.0
     tau_max = 1e6 * scale if tau_max is None else tau_max
+    if condition in ("spectral", "weighted_norm"):
+        # ‖R‖_P < 1 in R's own discrete-Lyapunov weight exactly when ρ(R) < 1; both limits
+        # are a root of |R(τλ)|² = 1, found as a polynomial root rather than by bisection
+        # (which a nearly undamped law defeats: |R(iy)| = 1 − O(y⁶) rounds to 1)
+        limit = _spectral_limit(A, scheme, tau_max)
+        # within rtol on the side where the condition holds (|R| = 1 at the root itself);
+        # there |R| may round to 1 when the limit is tiny (ξ → 0 for Euler: 2ξ/ω)
+        return limit * (1.0 - rtol) if math.isfinite(limit) else limit
 
     def holds(tau):
         return fn(step_matrix(A, scheme, tau)) < 1.0
@@ -251,7 +323,7 @@ def discrete(A_tilde, scheme, tau: float, *, limits: bool = True) -> Discrete:
     P = lyapunov_weight(R)
     out = Discrete(
         R=R,
-        spectral_radius=spectral_radius(R),
+        spectral_radius=spectral_radius_of(A, scheme, tau),
         norm_max=CONDITIONS["max_norm"](R),
         norm_2=CONDITIONS["two_norm"](R),
         norm_weighted=math.inf if P is None else weighted_norm(R, P),
