@@ -17,10 +17,12 @@ import pytest
 import xarray as xr
 
 from conftest import assert_schema
+from stabdae._schema import write_netcdf
 from stabdae.study.cli import main
 from stabdae.study.run import run_study
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src"
 
 STUDY = """
 [model]
@@ -210,3 +212,88 @@ def test_separate_scheduler_and_worker_processes_give_the_same_dataset(tmp_path)
         for proc in procs:
             proc.wait(timeout=60)
     same_data(xr.open_dataset(remote).load(), xr.open_dataset(local).load())
+
+
+def _interrupted(study, after: int, monkeypatch):
+    """Run ``study`` and stop it with an error after ``after`` grid points (as a kill
+    would), leaving their parts behind."""
+    import stabdae.study.run as runner
+
+    real, calls = runner.run_point, []
+
+    def stop_after(*args, **kwargs):
+        if len(calls) == after:
+            raise KeyboardInterrupt
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(runner, "run_point", stop_after)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(study, progress=False, log=lambda *a: None)
+    monkeypatch.setattr(runner, "run_point", real)
+
+
+def test_resume_after_a_model_edit_recomputes_and_equals_a_clean_run(tmp_path, monkeypatch):
+    """Parts computed with the model file as it was are not mixed with points of the
+    edited model: the run key covers the model file (and what it imports from its
+    folder), so the resumed run starts over and equals a clean run of the edited model."""
+    models = tmp_path / "models"
+    models.mkdir()
+    source = (ROOT / "kernels" / "pendulum.py").read_text()
+    (models / "pend.py").write_text(source)
+    text = STUDY.format(members=16, t_end=0.2, omegas="5.0").replace(
+        'file = "pendulum"', 'file = "models/pend.py"')
+    study = tmp_path / "study.toml"
+    study.write_text(text)
+    _interrupted(study, 2, monkeypatch)
+    assert len(list((tmp_path / "out" / "study.nc.parts").glob("point-*.nc"))) == 2
+    (models / "pend.py").write_text(source.replace('"g": 9.81', '"g": 1.62'))
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+    cmd = [sys.executable, "-m", "stabdae.study.cli", "run", str(study), "--quiet", "--no-plots"]
+    resumed = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
+    assert "changed since" in resumed.stdout and "starting over" in resumed.stdout
+    clean = tmp_path / "clean"
+    clean.mkdir()
+    (clean / "models").mkdir()
+    (clean / "models" / "pend.py").write_text((models / "pend.py").read_text())
+    (clean / "study.toml").write_text(text)
+    subprocess.run([*cmd[:4], str(clean / "study.toml"), "--quiet", "--no-plots"], env=env,
+                   capture_output=True, text=True, check=True)  # fmt: skip
+    got = xr.open_dataset(tmp_path / "out" / "study.nc").load()
+    assert got.attrs["model_param_g"] == 1.62
+    same_data(got, xr.open_dataset(clean / "out" / "study.nc").load())
+
+
+def test_force_and_bad_parts_are_computed_again(tmp_path, monkeypatch):
+    """Each part is checked before it is used: a part of another grid point, a truncated
+    and an empty part are computed again (and say so); --force discards parts that pass
+    the check too.  Every way ends with the dataset of a clean run."""
+    study = study_file(tmp_path, members=16, t_end=0.2, omegas="5.0")
+    (tmp_path / "ref").mkdir()
+    clean = run_study(study_file(tmp_path / "ref", members=16, t_end=0.2, omegas="5.0"),
+                      progress=False, log=lambda *a: None)  # fmt: skip
+    parts = tmp_path / "out" / "study.nc.parts"
+    _interrupted(study, 4, monkeypatch)
+    (parts / "point-0.nc").write_bytes((parts / "point-1.nc").read_bytes())  # a foreign part
+    data = (parts / "point-2.nc").read_bytes()
+    (parts / "point-2.nc").write_bytes(data[: len(data) // 2])  # truncated
+    (parts / "point-3.nc").write_bytes(b"")  # empty
+    said = []
+    out = run_study(study, progress=False, log=said.append)
+    said = "\n".join(map(str, said))
+    assert "grid point 0: point-0.nc holds grid point 1: computing it again" in said
+    assert "grid point 2: point-2.nc unreadable" in said
+    assert "grid point 3: point-3.nc unreadable" in said
+    assert "resuming: 1 of 6 grid points already done" in said
+    same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
+    # a part that passes the check but holds other numbers: kept on resume, not by --force
+    out.unlink()
+    _interrupted(study, 1, monkeypatch)
+    with xr.open_dataset(parts / "point-0.nc") as part:
+        tampered = part.load()
+    tampered["fraction_bounded"] = tampered.fraction_bounded * 0 + 0.5
+    write_netcdf(tampered, parts / "point-0.nc")
+    said = []
+    out = run_study(study, force=True, progress=False, log=said.append)
+    assert f"--force: discarding {parts}" in said
+    same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ._model import Model, ModelError
 
-__all__ = ["load_model", "scene_names", "scene_dir"]
+__all__ = ["load_model", "local_imports", "model_file", "scene_names", "scene_dir"]
 
 
 def scene_dir() -> Path:
@@ -24,6 +24,52 @@ def scene_dir() -> Path:
 def scene_names() -> list[str]:
     """Names of the built-in scenes (model files shipped with stabdae)."""
     return sorted(p.stem for p in scene_dir().glob("*.py") if not p.stem.startswith("_"))
+
+
+def model_file(source) -> Path:
+    """The resolved path of a model file or of a built-in scene's file."""
+    path = Path(source)
+    if path.suffix != ".py":
+        candidate = scene_dir() / f"{source}.py"
+        if not candidate.is_file():
+            raise ModelError(
+                f"load_model: {source!r} is neither a .py model file nor a built-in scene; "
+                f"scenes: {scene_names()}"
+            )
+        path = candidate
+    if not path.is_file():
+        raise ModelError(f"load_model: no such model file: {path}")
+    return path.resolve()
+
+
+def local_imports(path: Path) -> list[Path]:
+    """The model file and the modules of its own folder that it imports, recursively (what
+    its numbers can depend on besides the library)."""
+    import ast
+
+    seen: list[Path] = []
+    todo = [Path(path).resolve()]
+    while todo:
+        current = todo.pop()
+        if current in seen:
+            continue
+        seen.append(current)
+        try:
+            tree = ast.parse(current.read_text())
+        except (OSError, SyntaxError, ValueError):
+            continue
+        for node in ast.walk(tree):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            for name in names:
+                base = current.parent / Path(*name.split("."))
+                for candidate in (base.with_suffix(".py"), base / "__init__.py"):
+                    if candidate.is_file():
+                        todo.append(candidate.resolve())
+    return seen
 
 
 def load_model(source, attribute: str = "model") -> Model:
@@ -42,18 +88,7 @@ def load_model(source, attribute: str = "model") -> Model:
     >>> model.n, model.m
     (2, 1)
     """
-    path = Path(source)
-    if path.suffix != ".py":
-        candidate = scene_dir() / f"{source}.py"
-        if not candidate.is_file():
-            raise ModelError(
-                f"load_model: {source!r} is neither a .py model file nor a built-in scene; "
-                f"scenes: {scene_names()}"
-            )
-        path = candidate
-    if not path.is_file():
-        raise ModelError(f"load_model: no such model file: {path}")
-    path = path.resolve()
+    path = model_file(source)
     digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
     name = f"stabdae_model_{path.stem}_{digest}"
     if name in sys.modules:

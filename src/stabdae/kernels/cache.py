@@ -46,6 +46,7 @@ from .fma import HOST_FMA
 from .jit import JIT
 
 __all__ = ["cache_dir", "clear", "fingerprint", "function_fingerprint", "kernel_key", "keyed_cache",
+           "library_fingerprint",
            "memo", "tag"]
 
 
@@ -80,7 +81,7 @@ def clear() -> None:
 
 
 @cache
-def _library_fingerprint() -> str:
+def library_fingerprint() -> str:
     # the library's multiply-adds compile differently without FMA (.fma)
     text = f"numba {numba.__version__} py {sys.version_info[:2]} fma {HOST_FMA}"
     h = hashlib.sha256(text.encode())
@@ -139,7 +140,7 @@ def fingerprint(*parts) -> str | None:
     an absent piece); ``None`` if any part is :data:`UNKNOWN`."""
     if _has_unknown(parts):
         return None
-    h = hashlib.sha256(_library_fingerprint().encode())
+    h = hashlib.sha256(library_fingerprint().encode())
     for part in parts:
         h.update(b"\x00" + repr(part).encode())
     return h.hexdigest()

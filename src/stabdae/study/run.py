@@ -25,17 +25,20 @@ import xarray as xr
 
 from .._ensemble import ensemble
 from .._integrate import IntegrationWarning
+from .._loading import local_imports
 from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
+from ..kernels.cache import library_fingerprint
 from .report import summary
 from .spec import Study, load_study
 from .theory import axis_units, for_study
 
 __all__ = ["run_study", "run_point", "combine"]
 
-#: attributes that say when/how fast, not what: left out of the study dataset
+#: attributes that say when/how fast, not what, and the parts' bookkeeping: left out of
+#: the study dataset
 _VOLATILE = ("wall_sample_s", "wall_integrate_s", "wall_dataset_s", "created_at", "history",
-             "threads")  # fmt: skip
+             "threads", "stabdae_run_key", "grid_point")  # fmt: skip
 
 
 def axis_name(canon: str, all_names) -> str:
@@ -76,10 +79,34 @@ def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dat
 
 
 def _fingerprint(study: Study) -> str:
+    """The run key: everything that decides a grid point's numbers — the study file (its
+    parameters, law, scheme, run and grid), the ensemble settings as run (``--members``),
+    the model file and the modules of its folder that it imports, and the library (its
+    source, numba's version, FMA)."""
     h = hashlib.sha256(study.path.read_bytes())
     h.update(json.dumps(study.ensemble, sort_keys=True).encode())
     h.update(__version__.encode())
+    h.update(library_fingerprint().encode())
+    if study.model_file is not None:
+        for path in local_imports(study.model_file):
+            h.update(path.name.encode() + b"\0" + path.read_bytes())
     return h.hexdigest()
+
+
+def _part_ok(path: Path, index: int, stamp: str) -> str | None:
+    """Why the part file of grid point ``index`` cannot be used (None when it can): it
+    must open and carry this run's key and its own grid point."""
+    try:
+        with xr.open_dataset(path) as part:
+            key, point = part.attrs.get("stabdae_run_key"), part.attrs.get("grid_point")
+            part.load()
+    except Exception as exc:  # a truncated, empty or foreign file: any reader error
+        return f"unreadable ({type(exc).__name__})"
+    if key != stamp:
+        return "written by another run"
+    if point != index:
+        return f"holds grid point {point}"
+    return None
 
 
 def run_study(study, output=None, *, force: bool = False, members: int | None = None,
@@ -88,8 +115,11 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     """Run every grid point of ``study`` (a :class:`Study` or a path) and write the dataset.
 
     Returns the output path.  Raises ``FileExistsError`` when the output exists and
-    ``force`` is false.  Resumes from ``OUTPUT.parts`` when it belongs to the same study
-    file and ensemble settings (else an error; ``force`` starts over).
+    ``force`` is false.  Resumes from ``OUTPUT.parts`` when they are this study's: parts
+    written under another run key (the study file, its model or the library changed) are
+    discarded, and each part is checked before use (it opens, and carries the run key and
+    its own grid point; otherwise it is computed again).  ``OUTPUT.parts`` of another study
+    file is an error; ``force`` discards any parts and starts over.
     """
     if not isinstance(study, Study):
         study = load_study(study, members=members)
@@ -101,33 +131,49 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     parts = out.with_name(out.name + ".parts")
     stamp = _fingerprint(study)
     manifest = parts / "study.json"
-    if parts.exists():
-        old = json.loads(manifest.read_text()).get("fingerprint") if manifest.exists() else None
-        if old != stamp:
-            if not force:
-                raise FileExistsError(
-                    f"{parts} holds a run of a different study or ensemble; pass --force to "
-                    "discard it"
-                )
+    log(study.describe())
+    if parts.exists() and force:
+        log(f"--force: discarding {parts}")
+        shutil.rmtree(parts)
+    elif parts.exists():
+        try:
+            old = json.loads(manifest.read_text())
+        except (OSError, ValueError):
+            old = {}
+        if old.get("study") != str(study.path):
+            raise FileExistsError(
+                f"{parts} holds a run of a different study "
+                f"({old.get('study', 'unknown')}); pass --force to discard it"
+            )
+        if old.get("fingerprint") != stamp:
+            log(f"the study file, its model or the library changed since {parts} was "
+                "written: starting over")  # fmt: skip
             shutil.rmtree(parts)
     parts.mkdir(parents=True, exist_ok=True)
     manifest.write_text(json.dumps({"fingerprint": stamp, "study": str(study.path)}))
 
     points = list(study.points())
-    todo = [(i, values) for i, (_, values) in enumerate(points)
-            if not (parts / f"point-{i}.nc").exists()]  # fmt: skip
-    log(study.describe())
+    todo = []
+    for i, (_, values) in enumerate(points):
+        part = parts / f"point-{i}.nc"
+        if part.exists():
+            why = _part_ok(part, i, stamp)
+            if why is None:
+                continue
+            log(f"grid point {i}: {part.name} {why}: computing it again")
+            part.unlink()
+        todo.append((i, values))
     if len(todo) < len(points):
         log(f"resuming: {len(points) - len(todo)} of {len(points)} grid points already done")
     start = time.perf_counter()
     bar = _Progress(len(points), len(points) - len(todo), study.ensemble["members"], progress)
     try:
         if workers or scheduler:
-            _run_dask(study, todo, parts, workers, scheduler, bar)
+            _run_dask(study, todo, parts, workers, scheduler, bar, stamp)
         else:
             for i, values in todo:
                 ds = run_point(study, values, threads=threads, progress=bar.members)
-                write_netcdf(ds, parts / f"point-{i}.nc")
+                write_netcdf(_keyed(ds, i, stamp), parts / f"point-{i}.nc")
                 bar.point_done()
     finally:
         bar.close()
@@ -152,7 +198,13 @@ def _with_path_theory(study: Study, ds: xr.Dataset) -> xr.Dataset:
     return ds.assign({v: th[v].assign_coords({d: ds[d] for d in th[v].dims}) for v in keep})
 
 
-def _run_dask(study, todo, parts, workers, scheduler, bar):
+def _keyed(ds: xr.Dataset, index: int, stamp: str) -> xr.Dataset:
+    """A grid point's dataset marked with its index and the run key, as its part file."""
+    ds.attrs.update(stabdae_run_key=stamp, grid_point=index)
+    return ds
+
+
+def _run_dask(study, todo, parts, workers, scheduler, bar, stamp):
     from dask.distributed import Client, LocalCluster, as_completed
 
     if scheduler:
@@ -166,7 +218,8 @@ def _run_dask(study, todo, parts, workers, scheduler, bar):
         futures = {client.submit(_remote_point, path, members, values, pure=False): i
                    for i, values in todo}  # fmt: skip
         for fut in as_completed(futures):
-            write_netcdf(fut.result(), parts / f"point-{futures[fut]}.nc")
+            i = futures[fut]
+            write_netcdf(_keyed(fut.result(), i, stamp), parts / f"point-{i}.nc")
             bar.point_done()
     finally:
         client.close()

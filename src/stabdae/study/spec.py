@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .._laws import Law, LawError, baumgarte, matrix, none, theorem5
-from .._loading import load_model
+from .._loading import load_model, model_file
 from .._model import Model, ModelError
 from .._schemes import Scheme, SchemeError, as_scheme
 from .._validate import fixed_time_grid
@@ -64,6 +64,9 @@ class Study:
     ensemble: dict
     axes: dict = field(default_factory=dict)
     output: Path | None = None
+    #: the model's file (resolved), whose content, with what it imports from its own
+    #: folder, keys a run's parts
+    model_file: Path | None = None
 
     # ----------------------------------------------------------------- grid
     @property
@@ -260,7 +263,8 @@ def load_study(path, *, members: int | None = None) -> Study:
     study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
                   ensemble=ens, axes=axes,
                   output=None if output is None
-                  else Path(os.path.normpath(path.parent / output)))  # fmt: skip
+                  else Path(os.path.normpath(path.parent / output)),
+                  model_file=model_file(source))  # fmt: skip
 
     # every grid point must build (law shapes, time grid): try them all, cheaply
     for _, values in study.points():
