@@ -133,3 +133,146 @@ def test_a_kernel_loaded_from_the_cache_does_not_capture_a_fresh_compile(tmp_pat
     reference = run("double_pendulum", cache="off")
     assert both["pendulum"] == first["pendulum"]
     assert both["double_pendulum"] == reference["double_pendulum"]
+
+
+# ---------------------------------------------------------------- what the key covers
+MODEL_WITH_GLOBAL = '''
+import os
+import numpy as np
+from numba import njit
+import stabdae
+from helper_mod import radial_accel
+
+G = float(os.environ.get("STABDAE_TEST_G", "9.81"))  # read when the file is loaded
+
+
+@njit
+def forces(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = G
+
+
+@njit
+def f(t, q, p, out):
+    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
+
+
+@njit
+def f_q(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+
+
+@njit
+def f_accel(t, q, v, p, out):
+    out[0] = radial_accel(v)
+
+
+model = stabdae.Model("global_pendulum", n=2, m=1, forces=forces, f=f, f_q=f_q,
+                      f_accel=f_accel, reference_state=np.array([0.0, -1.0, 1.0, 0.0]))
+'''
+HELPER = '''
+from numba import njit
+
+
+@njit
+def radial_accel(v):
+    return 2.0 * (v[0] * v[0] + v[1] * v[1])
+'''
+RUN_MODEL = textwrap.dedent(
+    """
+    import importlib.util, json, sys, warnings
+    import stabdae
+    path, how = sys.argv[1], sys.argv[2]
+    sys.path.insert(0, str(__import__("pathlib").Path(path).parent))
+    if how == "unregistered":  # as plugin loaders and notebooks run a file
+        spec = importlib.util.spec_from_file_location("<dynamic>", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        model = module.model
+    else:
+        model = stabdae.load_model(path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = stabdae.integrate(model, None, stabdae.baumgarte(10.0), "rk4", 1e-3, 0.3)
+    print(json.dumps({"x": ds.x.values[-1].tolist(),
+                      "warnings": [str(w.message) for w in caught]}))
+    """
+)
+
+
+def _run_model(path, cache, how="load", **env_extra):
+    env = dict(os.environ, STABDAE_CACHE_DIR=str(cache), PYTHONPATH=str(SRC), **env_extra)
+    out = subprocess.run([sys.executable, "-c", RUN_MODEL, str(path), how], env=env,
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert out.returncode == 0, out.stderr[-3000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture
+def model_folder(tmp_path):
+    folder = tmp_path / "model"
+    folder.mkdir()
+    (folder / "global_pendulum.py").write_text(MODEL_WITH_GLOBAL)
+    (folder / "helper_mod.py").write_text(HELPER)
+    return folder / "global_pendulum.py"
+
+
+def test_a_global_read_at_run_time_and_an_edited_helper_are_in_the_key(model_folder, tmp_path):
+    """numba freezes a global's value into the compiled code: a second process with
+    another value must not reuse the first one's kernel.  And a helper module the model
+    imports from its folder is keyed by its content: editing it recompiles."""
+    cache = tmp_path / "cache"
+    earth = _run_model(model_folder, cache)
+    moon = _run_model(model_folder, cache, STABDAE_TEST_G="1.62")
+    moon_fresh = _run_model(model_folder, "off", STABDAE_TEST_G="1.62")
+    assert moon["x"] == moon_fresh["x"] and moon["x"] != earth["x"]
+    helper = model_folder.parent / "helper_mod.py"
+    helper.write_text(HELPER.replace("2.0 * (", "2.0 * 1.5 * ("))  # a different f_accel
+    edited = _run_model(model_folder, cache)
+    assert edited["x"] == _run_model(model_folder, "off")["x"] != earth["x"]
+
+
+def test_an_unregistered_module_runs_twice_in_a_fresh_cache(model_folder, tmp_path):
+    """A model module executed without being registered in sys.modules: the second
+    process must not crash on a kernel from the cache (it compiles again if it cannot
+    load it), and a properly loaded run afterwards still works."""
+    cache = tmp_path / "cache"
+    first = _run_model(model_folder, cache, "unregistered")
+    second = _run_model(model_folder, cache, "unregistered")
+    proper = _run_model(model_folder, cache)
+    assert first["x"] == second["x"] == proper["x"]
+
+
+def test_a_truncated_cache_and_an_unusable_cache_folder_still_compile_and_run(model_folder,
+                                                                              tmp_path):
+    """Every cache file cut in half: the next run compiles again, warns, and gives the same
+    numbers.  A cache folder that cannot be created (a file in its place): the run compiles
+    in memory and says so."""
+    cache = tmp_path / "cache"
+    first = _run_model(model_folder, cache)
+    files = [p for p in (cache / "kernels").iterdir() if p.is_file()]
+    assert files
+    for p in files:
+        data = p.read_bytes()
+        p.write_bytes(data[: len(data) // 2])
+    again = _run_model(model_folder, cache)
+    assert again["x"] == first["x"]
+    assert any("could not be loaded" in w for w in again["warnings"]), again["warnings"]
+    blocker = tmp_path / "not_a_folder"
+    blocker.write_text("a file where the cache folder would be")
+    blocked = _run_model(model_folder, blocker / "cache")
+    assert blocked["x"] == first["x"]
+    assert any("cache" in w for w in blocked["warnings"]), blocked["warnings"]
+
+
+def test_without_numbas_private_caching_api_kernels_compile_in_memory(monkeypatch):
+    from stabdae.kernels import cache as kc
+
+    monkeypatch.setattr(kc, "CACHING_API", False)
+    monkeypatch.setattr(kc, "_WARNED", set())
+    d = njit(lambda x: 2.0 * x)
+    before = d._cache
+    with pytest.warns(RuntimeWarning, match="kernel cache unavailable"):
+        assert kc.keyed_cache(d, "some-key") is d
+    assert d._cache is before and d(1.5) == 3.0

@@ -252,3 +252,30 @@ def test_integrate_errors():
         stabdae.integrate(model, None, None, "rk4", 0.1, 1.0)
     with pytest.raises(ValueError, match=r"^integrate: t_end must be after t0"):
         stabdae.integrate(model, None, law, "rk4", 0.1, 0.0)
+
+
+@njit
+def mass_asymmetric(t, q, p, out):
+    out[0, 0] = 1.0
+    out[0, 1] = 0.25
+    out[1, 0] = 0.0
+    out[1, 1] = 1.0
+
+
+def test_asymmetric_mass_matrix_is_refused():
+    """The L D Lᵀ factorization reads the lower triangle only: an asymmetric mass matrix
+    is refused at construction, naming the entries."""
+    with pytest.raises(stabdae.ModelError, match=r"mass\(t, q, p, out\) is not symmetric at "
+                                                 r"the reference state: out\[1, 0\] = 0\.0 but "
+                                                 r"out\[0, 1\] = 0\.25"):  # fmt: skip
+        unit_pendulum("asymmetric", mass=mass_asymmetric)
+
+
+def test_two_stage_without_parameters_and_parameters_of_a_fixed_scheme():
+    model = unit_pendulum()
+    law = stabdae.baumgarte(10.0)
+    with pytest.raises(stabdae.SchemeError, match=r"^integrate: scheme 'two_stage' needs its "
+                                                  r"parameters a and sigma"):  # fmt: skip
+        stabdae.integrate(model, None, law, "two_stage", 0.1, 1.0)
+    with pytest.raises(stabdae.SchemeError, match=r"scheme 'rk4' has no parameters, got \['a'\]"):
+        stabdae._schemes.as_scheme("rk4", a=0.5)

@@ -165,3 +165,24 @@ def test_cli_reports_study_errors(tmp_path, capsys):
     path = write(tmp_path, BASE.replace("tau = 1e-3", "tau = -1.0"))
     assert main(["theory", str(path)]) == 2
     assert "study.toml: [run] tau: must be positive" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["midpoint", "heun", "rk4", "euler"])
+def test_two_stage_sweep_with_a_fixed_scheme_is_refused(tmp_path, name):
+    """Sweeping a (or sigma) under a scheme without parameters was ignored silently (every
+    grid point the same); it is an error naming the key."""
+    text = BASE.replace('name = "rk2"', f'name = "{name}"') + "\n[sweep]\na = [0.5, 1.0]\n"
+    with pytest.raises(StudyError, match=rf"at scheme\.a = 0\.5: scheme '{name}' has no "
+                                         r"parameters, got \['a'\]"):  # fmt: skip
+        load_study(write(tmp_path, text))
+
+
+@pytest.mark.parametrize("name", ["rk2", "two_stage"])
+def test_two_stage_sweep_changes_the_scheme_per_point(tmp_path, name):
+    text = BASE.replace('name = "rk2"', f'name = "{name}"') + "\n[sweep]\na = [0.5, 0.25]\n"
+    text = text.replace("[scheme]\n", "[scheme]\nsigma = 2.0\n") if name == "two_stage" else text
+    study = load_study(write(tmp_path, text))
+    schemes = [study.setup(v)["scheme"] for _, v in study.points()]
+    assert [sc.params["a"] for sc in schemes] == [0.5, 0.25]
+    assert schemes[0].b.tolist() != schemes[1].b.tolist() or schemes[0].A.tolist() != \
+        schemes[1].A.tolist()

@@ -405,13 +405,29 @@ class Model:
         for piece, fn in self.functions.items():
             pattern, shape_of, governs = _PIECES[piece]
             args = (t, q, p) if pattern == "tqp" else (t, q, v, p)
-            probe_output(
+            out = probe_output(
                 f"Model {self.name!r}: {_call_signature(piece)}",
                 fn, args, shape_of(self.n, self.m, self.k),
                 f"{governs} from n={self.n}, m={self.m}, k={self.k}",
             )  # fmt: skip
+            if piece == "mass":
+                self._check_symmetric(out)
         if self.energy is not None:
             self._probe_energy(t, q, v, p)
+
+    def _check_symmetric(self, M: np.ndarray) -> None:
+        """The kernels factor M by L D Lᵀ from its lower triangle alone: an asymmetric
+        mass matrix would be read as another, symmetric one."""
+        tol = 1e-12 * max(float(np.abs(M).max()), np.finfo(float).tiny)
+        bad = np.argwhere(np.abs(M - M.T) > tol)
+        if bad.size:
+            i, j = (int(k) for k in bad[bad[:, 0] > bad[:, 1]][0])
+            raise ModelError(
+                f"Model {self.name!r}: mass(t, q, p, out) is not symmetric at the reference "
+                f"state: out[{i}, {j}] = {float(M[i, j])!r} but out[{j}, {i}] = "
+                f"{float(M[j, i])!r} (the "
+                "mass matrix is symmetric; only its lower triangle would be read)"
+            )
 
     def _probe_energy(self, t, q, v, p) -> None:
         try:

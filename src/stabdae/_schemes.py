@@ -247,7 +247,17 @@ def as_scheme(scheme, **params) -> Scheme:
         key = scheme.lower()
         if key in ("two_stage", "rk2") and params:
             return two_stage(params.get("a", 0.5), params.get("sigma", 1.0))
+        if key == "two_stage":
+            raise SchemeError(
+                "scheme 'two_stage' needs its parameters a and sigma (two_stage(a, sigma), or "
+                "a and sigma beside the name)"
+            )
         if key in _BY_NAME:
+            if params:  # a fixed scheme would silently ignore them
+                raise SchemeError(
+                    f"scheme {scheme!r} has no parameters, got {sorted(params)}: a and sigma "
+                    "belong to 'two_stage' (or 'rk2', the two-stage family)"
+                )
             return _BY_NAME[key]()
         raise SchemeError(
             f"unknown scheme {scheme!r}; known: {sorted(set(_BY_NAME) | {'two_stage'})}"

@@ -29,18 +29,26 @@ import inspect
 import os
 import shutil
 import sys
+import types
 import warnings
 from functools import cache
 from pathlib import Path
 
 import numba
 import numpy as np
-from numba.core.caching import (
-    CompileResultCacheImpl,
-    FunctionCache,
-    IndexDataCacheFile,
-    _CacheLocator,
-)
+
+try:  # numba's caching classes are private: without them kernels compile in memory
+    from numba.core.caching import (
+        CompileResultCacheImpl,
+        FunctionCache,
+        IndexDataCacheFile,
+        _CacheLocator,
+    )
+except ImportError:  # pragma: no cover - exercised by a test that hides the module
+    CompileResultCacheImpl = FunctionCache = IndexDataCacheFile = _CacheLocator = object
+    CACHING_API = False
+else:
+    CACHING_API = True
 
 from .fma import HOST_FMA
 from .jit import JIT
@@ -99,10 +107,12 @@ def _file_digest(path: str, mtime: float, size: int) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def function_fingerprint(fn) -> str | None:
+def function_fingerprint(fn, _seen=None) -> str | None:
     """``module.qualname:line@sha256(source file)`` of a dispatcher or Python function, with
-    the values it closes over; ``None`` when it has no source file or closes over something
-    other than numbers, strings, arrays or other fingerprintable functions."""
+    the values it closes over and the globals it reads (numbers, strings, arrays: numba
+    freezes them into the compiled code; functions: their own fingerprints, so that a
+    helper in another file is keyed by that file).  ``None`` when it has no source file or
+    reads something that has no fingerprint."""
     py_func = getattr(fn, "py_func", fn)
     try:
         path = inspect.getfile(py_func)
@@ -110,28 +120,62 @@ def function_fingerprint(fn) -> str | None:
         code = py_func.__code__
     except (TypeError, OSError, AttributeError):
         return None
+    seen = set() if _seen is None else _seen
+    if id(py_func) in seen:  # recursion: the function itself is already being keyed
+        return f"{py_func.__module__}.{py_func.__qualname__}"
+    seen.add(id(py_func))
     out = (f"{py_func.__module__}.{py_func.__qualname__}:{code.co_firstlineno}"
            f"@{_file_digest(path, st.st_mtime, st.st_size)}")  # fmt: skip
     cells = []
     for cell in py_func.__closure__ or ():
-        value = _value_fingerprint(cell.cell_contents)
+        value = _value_fingerprint(cell.cell_contents, seen)
         if value is None:
             return None
         cells.append(value)
-    return out + (f"[{','.join(cells)}]" if cells else "")
+    names = []
+    for name in sorted(_global_names(code)):
+        if name not in py_func.__globals__:
+            continue  # a builtin, or an attribute name
+        value = _value_fingerprint(py_func.__globals__[name], seen)
+        if value is None:
+            return None
+        names.append(f"{name}={value}")
+    return (out + (f"[{','.join(cells)}]" if cells else "")
+            + (f"{{{','.join(names)}}}" if names else ""))  # fmt: skip
 
 
-def _value_fingerprint(value) -> str | None:
+def _global_names(code) -> set[str]:
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= _global_names(const)
+    return names
+
+
+#: modules whose functions are keyed by name (their versions change with the library's)
+_LIBRARY_MODULES = ("math", "cmath", "numpy", "numba", "scipy", "stabdae", "builtins")
+
+
+def _value_fingerprint(value, seen=None) -> str | None:
     if value is None or isinstance(value, (bool, int, float, complex, str, bytes)):
         return f"{type(value).__name__}:{value!r}"
     if isinstance(value, np.ndarray):
         digest = hashlib.sha256(np.ascontiguousarray(value).tobytes()).hexdigest()
         return f"array:{value.dtype.str}:{value.shape}:{digest}"
+    if isinstance(value, np.generic):
+        return f"{type(value).__name__}:{value!r}"
     if isinstance(value, tuple):
-        parts = [_value_fingerprint(v) for v in value]
+        parts = [_value_fingerprint(v, seen) for v in value]
         return None if None in parts else f"({','.join(parts)})"
+    if isinstance(value, types.ModuleType):
+        return f"module:{value.__name__}"
+    module = getattr(value, "__module__", None) or ""
+    if callable(value) and module.split(".")[0] in _LIBRARY_MODULES:
+        return f"function:{module}.{getattr(value, '__qualname__', repr(value))}"
+    if isinstance(value, np.ufunc):
+        return f"ufunc:{value.__name__}"
     if callable(value):
-        return function_fingerprint(value)
+        return function_fingerprint(value, seen)
     return None
 
 
@@ -224,6 +268,37 @@ class _KeyedCache(FunctionCache):
     def _index_key(self, sig, codegen):
         return (sig, codegen.magic_tuple(), self._key)
 
+    def load_overload(self, sig, target_context):
+        """The cached kernel, or None (compile it) when the entry cannot be loaded: a
+        truncated file, another numba, a kernel whose model module cannot be imported."""
+        try:
+            return super().load_overload(sig, target_context)
+        except Exception as exc:
+            _warn_once(f"a cached kernel could not be loaded ({type(exc).__name__}: {exc}); "
+                       "compiling it again")  # fmt: skip
+            return None
+
+    def save_overload(self, sig, data):
+        """Store the kernel; a cache folder that cannot be written (read-only, full, a
+        file in its place) costs the next process a compilation, nothing else."""
+        try:
+            super().save_overload(sig, data)
+        except Exception as exc:
+            _warn_once(f"a kernel could not be written to the cache {self._cache_path} "
+                       f"({type(exc).__name__}: {exc}); it runs, compiled in memory")  # fmt: skip
+
+
+_WARNED: set[str] = set()
+
+
+def _warn_once(message: str) -> None:
+    kind = message.split(" (", 1)[0]
+    if kind not in _WARNED:
+        _WARNED.add(kind)
+        warnings.warn(f"stabdae: {message}", RuntimeWarning, stacklevel=3)
+
+
+
 
 def tag(key: str | None, *dispatchers) -> None:
     """Make the compiled symbol names of closures unique to ``key``.
@@ -252,9 +327,13 @@ def keyed_cache(dispatcher, key: str | None):
     path = cache_dir()
     if key is None or path is None or not JIT:
         return dispatcher
+    if not CACHING_API:
+        _warn_once("kernel cache unavailable (this numba has no numba.core.caching); "
+                   "compiling in memory")  # fmt: skip
+        return dispatcher
     try:
         dispatcher._cache = _KeyedCache(dispatcher.py_func, key, path / "kernels")
-    except Exception as exc:  # numba internals changed: compile without a cache
-        warnings.warn(f"stabdae: kernel cache unavailable ({exc!r}); compiling in memory",
-                      RuntimeWarning, stacklevel=2)  # fmt: skip
+    except Exception as exc:  # numba internals changed, or the folder is unusable
+        _warn_once(f"kernel cache unavailable ({type(exc).__name__}: {exc}); compiling in "
+                   "memory")  # fmt: skip
     return dispatcher

@@ -211,12 +211,14 @@ def load_study(path, *, members: int | None = None) -> Study:
     if "xi" in law and not law["xi"] >= 0:
         fail("[law] xi", f"must be non-negative, got {law['xi']}")
 
-    # scheme
+    # scheme (two_stage may take a and sigma from the sweep alone)
     scheme = dict(raw.get("scheme", {}))
-    try:
-        _make_scheme(scheme)
-    except SchemeError as exc:
-        fail("[scheme] name", str(exc))
+    swept = {k.removeprefix("scheme.") for k in raw.get("sweep", {})}
+    if not (str(scheme.get("name", "")).lower() == "two_stage" and swept & {"a", "sigma"}):
+        try:
+            _make_scheme(scheme)
+        except SchemeError as exc:
+            fail("[scheme] name", str(exc))
 
     # run
     run = dict(raw["run"])
@@ -251,6 +253,10 @@ def load_study(path, *, members: int | None = None) -> Study:
             fail(f"[sweep] {name}", f"sweeps {canon} twice")
         axes[canon] = values
         _check_axis(canon, values, f"[sweep] {name}", fail)
+
+    for key in ("a", "sigma"):  # the base point of a two-stage sweep: its first value
+        if f"scheme.{key}" in axes:
+            scheme.setdefault(key, float(axes[f"scheme.{key}"][0]))
 
     if "run.tau" in axes:
         span = run["t_end"] - model.t0
