@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import xarray as xr
 
@@ -47,3 +48,56 @@ def test_bad_input_exits_with_a_message(tmp_path):
     )  # fmt: skip
     assert proc.returncode == 2
     assert "must be a whole multiple of tau = 0.3" in proc.stderr
+
+
+def _installed(*args, cwd=None):
+    """The installed command line (stabdae on PATH next to this Python)."""
+    exe = Path(sys.executable).with_name("stabdae")
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "stabdae.study.cli"]
+    return subprocess.run([*cmd, *args], capture_output=True, text=True, cwd=cwd, timeout=600)
+
+
+def test_version_and_one_line_errors(tmp_path):
+    """--version; a missing dataset, a model file with a syntax error and bad worker counts
+    give one line on stderr and exit 2, no traceback."""
+    import stabdae
+
+    out = _installed("--version")
+    assert out.returncode == 0 and out.stdout.strip() == f"stabdae {stabdae.__version__}"
+    out = _installed("plot", str(tmp_path / "nope.nc"))
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert out.stderr.startswith("stabdae plot: error:") and "nope.nc" in out.stderr
+    bad = tmp_path / "bad_model.py"
+    bad.write_text("import stabdae\nmodel = (\n")
+    out = _installed("check", str(bad))
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert f"{bad}:2: SyntaxError" in out.stderr or f"{bad}:3: SyntaxError" in out.stderr
+    for workers in ("-1", "0", "two"):
+        out = _installed("run", "study.toml", "--workers", workers)
+        assert out.returncode == 2 and "--workers: expected a positive integer" in out.stderr
+
+
+def test_run_output_folder_orphans_and_foreign_files(tmp_path):
+    """-o with a folder writes <study>.nc inside it; a temporary file left by a killed write
+    is removed; a file that is not a stabdae dataset is not replaced, even with --force."""
+    from test_run import study_file
+
+    study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
+    folder = tmp_path / "outdir"
+    folder.mkdir()
+    orphan = folder / ".study.nc.abc123.tmp"
+    orphan.write_bytes(b"half a dataset")
+    out = _installed("run", str(study), "-o", str(folder), "--force", "--quiet", "--no-plots")
+    assert out.returncode == 0, out.stderr
+    assert (folder / "study.nc").is_file() and not orphan.exists()
+    with xr.open_dataset(folder / "study.nc") as ds:
+        assert "stabdae_version" in ds.attrs
+    new = tmp_path / "newdir"
+    out = _installed("run", str(study), "-o", f"{new}/", "--quiet", "--no-plots")
+    assert out.returncode == 0 and (new / "study.nc").is_file(), out.stderr
+    precious = tmp_path / "notes.nc"
+    precious.write_text("my notes")
+    out = _installed("run", str(study), "-o", str(precious), "--force", "--quiet",
+                     "--no-plots")  # fmt: skip
+    assert out.returncode == 2 and "is not a stabdae dataset" in out.stderr
+    assert precious.read_text() == "my notes"

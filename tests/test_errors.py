@@ -279,3 +279,11 @@ def test_two_stage_without_parameters_and_parameters_of_a_fixed_scheme():
         stabdae.integrate(model, None, law, "two_stage", 0.1, 1.0)
     with pytest.raises(stabdae.SchemeError, match=r"scheme 'rk4' has no parameters, got \['a'\]"):
         stabdae._schemes.as_scheme("rk4", a=0.5)
+
+
+@pytest.mark.parametrize("name", ["k/m", "g ", "2g", ""])
+def test_parameter_names_must_be_identifiers(name):
+    """Parameter names become NetCDF attribute names (model_param_<name>): a name NetCDF
+    refuses is refused when the model is built, not after a computation."""
+    with pytest.raises(stabdae.ModelError, match=r"parameter names must be identifiers"):
+        unit_pendulum("named", params={name: 1.0})

@@ -181,6 +181,7 @@ def _bad_calls():
         ("ensemble", lambda: stabdae.ensemble(m(), law, seed=-1)),
         ("ensemble", lambda: stabdae.ensemble(m(), law, x0=np.zeros((2, 3)))),
         ("ensemble", lambda: stabdae.ensemble(m(), law, block=0)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, block=10**6)),  # past the stack
         ("ensemble", lambda: stabdae.ensemble(m(), law, threads=0)),
         ("ensemble", lambda: stabdae.ensemble(m(), law, residual_dtype="float16")),
         ("ensemble", lambda: stabdae.ensemble(m(), law, epsilon=-1.0)),

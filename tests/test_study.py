@@ -186,3 +186,32 @@ def test_two_stage_sweep_changes_the_scheme_per_point(tmp_path, name):
     assert [sc.params["a"] for sc in schemes] == [0.5, 0.25]
     assert schemes[0].b.tolist() != schemes[1].b.tolist() or schemes[0].A.tolist() != \
         schemes[1].A.tolist()
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (('file = "pendulum"', 'file = "pendulum"\nparams = { g = nan }'),
+         r"\[model\] params.g: must be finite"),
+        (("seed = 1", "seed = -1"), r"\[ensemble\] seed: must be a non-negative integer"),
+        (("seed = 1", "seed = 1\nblock = 1000000"),
+         r"\[ensemble\] block: block = 1000000 needs .* MiB of thread stack"),
+        (("seed = 1", "seed = 1\n[sweep]\ntau = { linspace = [1e-3, 1e-2, 1000000000] }"),
+         r"\[sweep\] tau: linspace of 1000000000 values: at most 100000 per axis"),
+        (("seed = 1", "seed = 1\n[sweep]\ntau = { logspace = [1e-4, 1e-2, 2000] }\n"
+                      "omega = { linspace = [1, 100, 2000] }"),
+         r"\[sweep\]: 4e\+06 grid points: at most 1000000"),
+        (("seed = 1", 'seed = 1\n[output]\npath = "/tmp/elsewhere.nc"'),
+         r"\[output\] path: must be a relative path beneath the study's folder"),
+        (("seed = 1", 'seed = 1\n[output]\npath = "../up.nc"'),
+         r"\[output\] path: must be a relative path beneath"),
+    ],
+)
+def test_study_file_values_refused_before_anything_runs(tmp_path, edit, message):
+    """NaN parameters, a negative seed, a block that cannot fit the thread stack, grids too
+    large to run, and an output outside the study's folder: errors naming the key, before
+    anything compiles."""
+    text = BASE.replace(*edit)
+    assert text != BASE
+    with pytest.raises(StudyError, match=message):
+        load_study(write(tmp_path, text))

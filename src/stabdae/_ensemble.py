@@ -237,7 +237,7 @@ def ensemble(
     else:
         nsteps, save_every = check.fixed_time_grid(span, tau, save_dt, who,
                                                    default_samples=DEFAULT_SAMPLES)  # fmt: skip
-    block = check.count(block, "block", who)
+    block = check.block(block, model.n, who)
     rdtype = check.dtype(residual_dtype, "residual_dtype", ("float32", "float64"), who)
     low, high = check.radius(radius, who)
     seed = check.seed(seed, who)

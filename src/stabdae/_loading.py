@@ -99,6 +99,10 @@ def load_model(source, attribute: str = "model") -> Model:
         sys.modules[name] = module
         try:
             spec.loader.exec_module(module)
+        except (SyntaxError, ImportError) as exc:  # the file's own error, in one line
+            del sys.modules[name]
+            where = f"{path}:{exc.lineno}" if getattr(exc, "lineno", None) else str(path)
+            raise ModelError(f"load_model: {where}: {type(exc).__name__}: {exc}") from exc
         except BaseException:
             del sys.modules[name]
             raise

@@ -338,6 +338,12 @@ class Model:
                 f"Model {self.name!r}: params must be a mapping of names to floats, "
                 f"got {type(params).__name__}"
             )
+        for key in params:  # they become NetCDF attribute names (model_param_<name>)
+            if not (isinstance(key, str) and key.isidentifier()):
+                raise ModelError(
+                    f"Model {self.name!r}: parameter names must be identifiers (letters, "
+                    f"digits and _, not starting with a digit), got {key!r}"
+                )
         return {str(k): _finite_float(v, f"parameter {k!r}") for k, v in params.items()}
 
     def _validate_names(self, coordinates) -> tuple[str, ...]:

@@ -22,7 +22,8 @@ from ._schemes import Scheme, SchemeError, as_scheme
 from .kernels.rhs import LAW_ACPR, MULTIPLIERS, PROJECTIONS
 
 __all__ = [
-    "bound_law", "choice", "count", "dtype", "fixed_time_grid", "initial_state", "initial_states",
+    "block", "bound_law", "choice", "count", "dtype", "fixed_time_grid", "initial_state",
+    "initial_states",
     "law", "model", "multiplier", "params", "positive", "projection", "radius", "real",
     "sample_times", "scheme", "seed", "span", "whole_multiple",
 ]  # fmt: skip
@@ -103,6 +104,26 @@ def count(value, name: str, who: str) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise ValueError(f"{who}: {name} must be a positive integer, got {value!r}")
     return int(value)
+
+
+#: stack a block of the ensemble kernel may take for its two copies of the states
+#: (worker threads get 8 MiB by default; the rest is the member slot's own buffers)
+BLOCK_STACK_BYTES = 2**20
+
+
+def block(value, n: int, who: str, name: str = "block") -> int:
+    """Members per lockstep block: a positive integer whose states fit the thread's stack
+    (two copies of 2n doubles per member)."""
+    value = count(value, name, who)
+    per_member = 2 * 2 * n * 8 + 8
+    most = BLOCK_STACK_BYTES // per_member
+    if value > most:
+        raise ValueError(
+            f"{who}: {name} = {value} needs {value * per_member / 2**20:.1f} MiB of thread "
+            f"stack for the block's states (two copies of 2n = {2 * n} doubles per member); "
+            f"at most {most} for this model (64, the default, is as fast)"
+        )
+    return value
 
 
 def seed(value, who: str) -> int:

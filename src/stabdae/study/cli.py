@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .._version import __version__
+
 
 def _params(pairs: list[str]) -> dict[str, float]:
     out = {}
@@ -21,6 +23,16 @@ def _params(pairs: list[str]) -> dict[str, float]:
         except ValueError:
             raise SystemExit(f"stabdae: --param {key}: {val!r} is not a number") from None
     return out
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+    return value
 
 
 def _cmd_check(args) -> int:
@@ -177,6 +189,7 @@ def main(argv: list[str] | None = None) -> int:
         prog="stabdae",
         description="Stability of the constraint manifold under numerical integration.",
     )
+    parser.add_argument("--version", action="version", version=f"stabdae {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     chk = sub.add_parser("check", help="check a model's derivatives by finite differences")
@@ -219,7 +232,8 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--members", type=int, help="override [ensemble] members")
     run.add_argument("--force", action="store_true", help="overwrite an existing output")
     grp = run.add_mutually_exclusive_group()
-    grp.add_argument("--workers", type=int, help="start a local dask cluster of N workers")
+    grp.add_argument("--workers", type=_positive_int, metavar="N",
+                     help="start a local dask cluster of N worker processes")
     grp.add_argument("--scheduler", help="address of a running dask scheduler")
     run.add_argument("--threads", type=int, help="threads per ensemble (default: all cores)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -242,9 +256,18 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (ValueError, FileExistsError) as exc:  # StudyError, ModelError, LawError, …
+    except (ValueError, TypeError, OSError) as exc:  # StudyError, ModelError, a file, …
         print(f"stabdae {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print(f"stabdae {args.command}: error: not enough memory (fewer members, or fewer "
+              "stored samples: a larger save_dt)", file=sys.stderr)  # fmt: skip
+        return 2
+    except KeyboardInterrupt:
+        done = " (the grid points done are kept: run the same command to resume)" \
+            if args.command == "run" else ""
+        print(f"stabdae {args.command}: interrupted{done}", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

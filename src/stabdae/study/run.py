@@ -109,6 +109,26 @@ def _part_ok(path: Path, index: int, stamp: str) -> str | None:
     return None
 
 
+def output_path(study: Study, output=None) -> Path:
+    """Where the study's dataset goes: ``output`` (a file, or a folder — an existing one or
+    one written with a trailing slash — which gets ``<study>.nc``), else the study's
+    ``[output] path``, else ``results/<study>.nc``."""
+    if output is None:
+        return study.output or Path("results") / f"{study.path.stem}.nc"
+    out = Path(output)
+    if out.is_dir() or str(output).endswith(("/", "\\")):
+        return out / f"{study.path.stem}.nc"
+    return out
+
+
+def _is_stabdae_dataset(path: Path) -> bool:
+    try:
+        with xr.open_dataset(path) as ds:
+            return "stabdae_version" in ds.attrs
+    except Exception:  # not NetCDF, or unreadable
+        return False
+
+
 def run_study(study, output=None, *, force: bool = False, members: int | None = None,
               workers: int | None = None, scheduler: str | None = None, progress: bool = True,
               threads: int | None = None, log=print) -> Path:  # fmt: skip
@@ -123,11 +143,14 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     """
     if not isinstance(study, Study):
         study = load_study(study, members=members)
-    out = Path(output) if output is not None else study.output
-    if out is None:
-        out = Path("results") / f"{study.path.stem}.nc"
+    out = output_path(study, output)
     if out.exists() and not force:
         raise FileExistsError(f"{out} exists; pass --force to overwrite it")
+    if out.exists() and not _is_stabdae_dataset(out):
+        raise FileExistsError(f"{out} exists and is not a stabdae dataset; it is not replaced "
+                              "(give another output with -o)")  # fmt: skip
+    for orphan in out.parent.glob(f".{out.name}.*.tmp"):  # left by a write that was killed
+        orphan.unlink(missing_ok=True)
     parts = out.with_name(out.name + ".parts")
     stamp = _fingerprint(study)
     manifest = parts / "study.json"
@@ -214,7 +237,8 @@ def _run_dask(study, todo, parts, workers, scheduler, bar, stamp):
                                processes=True, dashboard_address=None)  # fmt: skip
         client = Client(cluster)
     try:
-        path, members = str(study.path), study.ensemble["members"]
+        # an absolute path: the workers may run in another folder
+        path, members = str(study.path.resolve()), study.ensemble["members"]
         futures = {client.submit(_remote_point, path, members, values, pure=False): i
                    for i, values in todo}  # fmt: skip
         for fut in as_completed(futures):
@@ -281,14 +305,23 @@ class _Progress:
             try:
                 from tqdm import tqdm
 
+                # the first chunk waits for the kernels to compile (or load from the cache)
                 self._bar = tqdm(total=points * members, initial=done * members,
-                                 unit="member", desc="stabdae run", file=sys.stderr,
-                                 dynamic_ncols=True)  # fmt: skip
+                                 unit="member", desc="stabdae run (compiling)",
+                                 file=sys.stderr, dynamic_ncols=True)  # fmt: skip
             except ImportError:
                 self._bar = None
+                print("stabdae run: compiling the kernels (first use only) …", file=sys.stderr)
         self._last = 0
+        self._started = time.perf_counter()
+        self._compiling = True
 
     def members(self, done: int, total: int):
+        if self._compiling:
+            self._compiling = False
+            if self._bar is not None:
+                seconds = time.perf_counter() - self._started
+                self._bar.set_description(f"stabdae run (kernels ready in {seconds:.0f} s)")
         if self._bar is not None:
             self._bar.update(done - self._last)
             self._last = done

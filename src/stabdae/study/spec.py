@@ -24,7 +24,7 @@ from .._laws import Law, LawError, baumgarte, matrix, none, theorem5
 from .._loading import load_model, model_file
 from .._model import Model, ModelError
 from .._schemes import Scheme, SchemeError, as_scheme
-from .._validate import fixed_time_grid
+from .._validate import block, fixed_time_grid
 
 __all__ = ["Study", "StudyError", "load_study"]
 
@@ -191,6 +191,8 @@ def load_study(path, *, members: int | None = None) -> Study:
             fail(f"[model] params.{key}", f"model {model.name!r} has no parameter {key!r}; "
                  f"its parameters: {', '.join(params) or 'none'}")  # fmt: skip
         params[key] = _typed(val, float, f"[model] params.{key}", fail)
+        if not math.isfinite(params[key]):
+            fail(f"[model] params.{key}", f"must be finite, got {params[key]}")
 
     # law
     law = dict(raw["law"])
@@ -241,8 +243,12 @@ def load_study(path, *, members: int | None = None) -> Study:
     if not (0 < radius[0] <= radius[1] and math.isfinite(radius[1])):
         fail("[ensemble] radius", f"needs 0 < low <= high, got {radius}")
     ens["radius"] = radius
-    if ens["block"] < 1:
-        fail("[ensemble] block", f"must be at least 1, got {ens['block']}")
+    if ens["seed"] < 0:
+        fail("[ensemble] seed", f"must be a non-negative integer, got {ens['seed']}")
+    try:
+        block(ens["block"], model.n, "study", "block")
+    except ValueError as exc:
+        fail("[ensemble] block", str(exc).removeprefix("study: "))
 
     # sweep
     axes = {}
@@ -253,6 +259,9 @@ def load_study(path, *, members: int | None = None) -> Study:
             fail(f"[sweep] {name}", f"sweeps {canon} twice")
         axes[canon] = values
         _check_axis(canon, values, f"[sweep] {name}", fail)
+        size = math.prod(len(v) for v in axes.values())
+        if size > MAX_POINTS:
+            fail("[sweep]", f"{size:.3g} grid points: at most {MAX_POINTS} (one ensemble each)")
 
     for key in ("a", "sigma"):  # the base point of a two-stage sweep: its first value
         if f"scheme.{key}" in axes:
@@ -266,6 +275,11 @@ def load_study(path, *, members: int | None = None) -> Study:
         run["tau"] = float(axes["run.tau"][0])
 
     output = raw.get("output", {}).get("path")
+    if output is not None:  # a study file is data: it writes only beneath its own folder
+        rel = Path(output)
+        if rel.is_absolute() or ".." in rel.parts or not rel.parts:
+            fail("[output] path", f"must be a relative path beneath the study's folder, got "
+                 f"{output!r} (give another place with stabdae run -o)")  # fmt: skip
     study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
                   ensemble=ens, axes=axes,
                   output=None if output is None
@@ -336,6 +350,12 @@ def _sweepable_list(model, law) -> str:
     return f"not a sweepable parameter; sweepable here: {', '.join(names)}"
 
 
+#: values per sweep axis, and grid points in all, a study may have (checked before any array
+#: is built: a grid of 1e10 points cannot be run, and would not be noticed until late)
+MAX_AXIS = 100_000
+MAX_POINTS = 1_000_000
+
+
 def _axis_values(spec, key, fail) -> np.ndarray:
     if isinstance(spec, list):
         if not spec or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
@@ -351,6 +371,8 @@ def _axis_values(spec, key, fail) -> np.ndarray:
                 and args[2] >= 1 and all(isinstance(a, (int, float)) for a in args[:2])):
             fail(key, f"{how} needs [start, stop, count] with an integer count, got {args!r}")
         a, b, n = float(args[0]), float(args[1]), args[2]
+        if n > MAX_AXIS:
+            fail(key, f"{how} of {n} values: at most {MAX_AXIS} per axis")
         if how == "logspace":
             if not (a > 0 and b > 0):
                 fail(key, f"logspace needs positive ends (the values themselves), got {args!r}")
