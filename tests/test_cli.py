@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import xarray as xr
 
 from conftest import KERNELS, ROOT
@@ -101,3 +102,20 @@ def test_run_output_folder_orphans_and_foreign_files(tmp_path):
                      "--no-plots")  # fmt: skip
     assert out.returncode == 2 and "is not a stabdae dataset" in out.stderr
     assert precious.read_text() == "my notes"
+
+
+def test_integrate_with_rk3_and_with_a_tableau(tmp_path, capsys):
+    tableau = '{"A": [[0, 0], [1, 0]], "b": [0.5, 0.5], "c": [0, 1], "order": 2}'
+    out = tmp_path / "tab.nc"
+    assert main(["integrate", "pendulum", "--tableau", tableau, "--t-end", "0.2",
+                 "-o", str(out)]) == 0  # fmt: skip
+    heun = tmp_path / "heun.nc"
+    assert main(["integrate", "pendulum", "--scheme", "heun", "--t-end", "0.2",
+                 "-o", str(heun)]) == 0  # fmt: skip
+    with xr.open_dataset(out) as a, xr.open_dataset(heun) as b:
+        assert a.attrs["scheme"] == "custom"
+        np.testing.assert_array_equal(a.x.values, b.x.values)  # the same tableau as Heun's
+    assert main(["integrate", "pendulum", "--scheme", "rk3", "--t-end", "0.2",
+                 "-o", str(tmp_path / "rk3.nc")]) == 0  # fmt: skip
+    assert main(["integrate", "pendulum", "--tableau", "[1, 2]"]) == 2
+    assert "a tableau needs A, b, c and order" in capsys.readouterr().err

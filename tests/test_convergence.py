@@ -19,6 +19,8 @@ SCHEMES = {
     "midpoint": (stabdae.midpoint, 2, 0.01),
     "heun": (stabdae.heun, 2, 0.01),
     "two_stage_a0.25": (lambda: stabdae.two_stage(0.25, 2.0), 2, 0.01),
+    "rk3": (stabdae.rk3, 3, 0.02),
+    "heun3": (stabdae.heun3, 3, 0.02),
     "rk4": (stabdae.rk4, 4, 0.02),
 }
 

@@ -287,3 +287,17 @@ def test_parameter_names_must_be_identifiers(name):
     refuses is refused when the model is built, not after a computation."""
     with pytest.raises(stabdae.ModelError, match=r"parameter names must be identifiers"):
         unit_pendulum("named", params={name: 1.0})
+
+
+def test_a_missing_f_t_is_named():
+    """Time-dependent constraints without f_t: the inconsistent reference state is
+    reported with the likely cause."""
+    from conftest import scene_module
+
+    mod = scene_module("pendulum_varying_length")
+    with pytest.raises(stabdae.ModelError, match=r"f changes with t but the model gives no "
+                                                 r"f_t\(t, q, p, out\)"):  # fmt: skip
+        stabdae.Model("no_f_t", n=2, m=1, params={"g": 9.81, "l0": 1.0, "eps": 0.1,
+                                                   "Omega": 3.0},
+                      reference_state=mod.reference_state, forces=mod.forces, f=mod.f,
+                      f_q=mod.f_q, f_accel=mod.f_accel)  # fmt: skip

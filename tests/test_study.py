@@ -7,6 +7,7 @@ import textwrap
 import numpy as np
 import pytest
 
+import stabdae
 from stabdae.study.cli import main
 from stabdae.study.spec import StudyError, load_study
 
@@ -215,3 +216,18 @@ def test_study_file_values_refused_before_anything_runs(tmp_path, edit, message)
     assert text != BASE
     with pytest.raises(StudyError, match=message):
         load_study(write(tmp_path, text))
+
+
+def test_a_tableau_in_the_study_file(tmp_path):
+    """[scheme] with A, b, c and order: the user's own scheme (here Kutta's third order,
+    written out), checked against the order conditions and recorded in the dataset."""
+    tableau = 'A = [[0, 0, 0], [0.5, 0, 0], [-1, 2, 0]]\nb = [0.16666666666666666, ' \
+              '0.6666666666666666, 0.16666666666666666]\nc = [0, 0.5, 1]\norder = 3\n'
+    text = BASE.replace('name = "rk2"', 'name = "my_kutta"\n' + tableau)
+    scheme = load_study(write(tmp_path, text)).setup()["scheme"]
+    assert scheme.name == "my_kutta" and scheme.order == 3
+    np.testing.assert_array_equal(scheme.b, stabdae.rk3().b)
+    assert "scheme_b" in scheme.attrs()
+    wrong = text.replace("order = 3", "order = 4")
+    with pytest.raises(StudyError, match=r"\[scheme\] name: .*declared order 4"):
+        load_study(write(tmp_path, wrong, "wrong.toml"))

@@ -315,7 +315,8 @@ def _exact_spectral_limit(omega, xi, coeffs):
 
 
 @pytest.mark.parametrize("xi", [0.0, 1e-9, 0.25, 0.5, 1 / math.sqrt(2), 1.0, 2.0])
-@pytest.mark.parametrize("scheme", ["euler", "midpoint", "heun", "rk4", "dopri5"])
+@pytest.mark.parametrize("scheme", ["euler", "midpoint", "heun", "rk3", "heun3", "rk4",
+                                    "dopri5"])  # fmt: skip
 def test_spectral_tau_limit_exact_for_every_damping(scheme, xi):
     """τ limits against the exact limits of the damped oscillator for undamped, nearly
     undamped, under-, critically and over-damped Baumgarte laws (RK4's 2√2/ω at ξ = 0,
@@ -334,6 +335,8 @@ def test_spectral_tau_limit_exact_for_every_damping(scheme, xi):
         assert theory.tau_limit(A, scheme, "weighted_norm", rtol=1e-10) == got
     if scheme == "rk4" and xi == 0.0:
         assert got == pytest.approx(2 * math.sqrt(2) / omega, rel=1e-9)
+    if scheme in ("rk3", "heun3") and xi == 0.0:  # both have R(z) = 1 + z + z²/2 + z³/6
+        assert got == pytest.approx(math.sqrt(3) / omega, rel=1e-9)
     if xi == 1.0:  # R(τÃ) for Euler at τω = 0.1: a Jordan block of eigenvalue 0.9
         rho = theory.discrete(A, "euler", 0.1 / omega, limits=False).spectral_radius
         assert rho == pytest.approx(0.9, rel=1e-14)

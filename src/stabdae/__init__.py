@@ -14,7 +14,18 @@ from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, acpr, baumgarte, matrix, none, theorem5, user
 from ._loading import load_model, scene_names
 from ._model import Model, ModelError
-from ._schemes import Scheme, SchemeError, dopri5, euler, heun, midpoint, rk4, two_stage
+from ._schemes import (
+    Scheme,
+    SchemeError,
+    dopri5,
+    euler,
+    heun,
+    heun3,
+    midpoint,
+    rk3,
+    rk4,
+    two_stage,
+)
 from ._status import Status
 from ._version import __version__
 
@@ -34,12 +45,14 @@ __all__ = [
     "ensemble",
     "euler",
     "heun",
+    "heun3",
     "integrate",
     "integrate_adaptive",
     "load_model",
     "matrix",
     "midpoint",
     "none",
+    "rk3",
     "rk4",
     "sample_perturbations",
     "scene_names",

@@ -462,7 +462,21 @@ class Model:
             raise ModelError(
                 f"Model {self.name!r}: reference_state is not on the constraint manifold at "
                 f"t0={self.t0}: residual components above {tol:.1e}: {bad}"
+                + self._missing_time_derivative_hint(x, p)
             )
+
+    def _missing_time_derivative_hint(self, x: np.ndarray, p: np.ndarray) -> str:
+        """When the constraints change with t but the model declares no f_t / h_t: the
+        likely cause of an inconsistent ḟ or h, named."""
+        dt = 1e-6 * max(1.0, abs(self.t0))
+        moved = self.residual(x, self.t0 + dt, p) - self.residual(x, self.t0, p)
+        hints = []
+        if self.m and "f_t" not in self.functions and np.abs(moved[: self.m]).max() > 0:
+            hints.append("f changes with t but the model gives no f_t(t, q, p, out) (∂f/∂t, "
+                         "also part of f_accel)")  # fmt: skip
+        if self.k and "h_t" not in self.functions and np.abs(moved[2 * self.m:]).max() > 0:
+            hints.append("h changes with t but the model gives no h_t(t, q, v, p, out)")
+        return "; " + "; ".join(hints) if hints else ""
 
 
 # --------------------------------------------------------------------- helpers

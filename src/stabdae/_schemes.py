@@ -101,7 +101,10 @@ class Scheme:
         return np.array(coeffs)
 
     def attrs(self) -> dict:
-        return {"scheme": self.name, "scheme_order": self.order, **self.params}
+        out = {"scheme": self.name, "scheme_order": self.order, **self.params}
+        if self.name not in _BY_NAME and self.name != "two_stage":  # a user's tableau
+            out.update(scheme_A=self.A.ravel(), scheme_b=self.b, scheme_c=self.c)
+        return out
 
     def __repr__(self) -> str:
         extra = "".join(f", {k}={v}" for k, v in self.params.items())
@@ -197,6 +200,20 @@ def heun() -> Scheme:
     return two_stage(1.0, 0.5, name="heun")
 
 
+def rk3() -> Scheme:
+    """Kutta's third-order method (Hairer, Nørsett & Wanner I, II.1, Table 1.1): ``c = (0, ½,
+    1)``, ``b = (1/6, 2/3, 1/6)``."""
+    return Scheme("rk3", [[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [-1.0, 2.0, 0.0]],
+                  [1 / 6, 2 / 3, 1 / 6], [0.0, 0.5, 1.0], 3, {})  # fmt: skip
+
+
+def heun3() -> Scheme:
+    """Heun's third-order method (Hairer, Nørsett & Wanner I, II.1, Table 1.1): ``c = (0,
+    ⅓, ⅔)``, ``b = (¼, 0, ¾)``."""
+    return Scheme("heun3", [[0.0, 0.0, 0.0], [1 / 3, 0.0, 0.0], [0.0, 2 / 3, 0.0]],
+                  [0.25, 0.0, 0.75], [0.0, 1 / 3, 2 / 3], 3, {})  # fmt: skip
+
+
 def rk4() -> Scheme:
     """The classical fourth-order Runge–Kutta scheme."""
     A = [[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]]
@@ -234,8 +251,24 @@ def dopri5_embedded_weights() -> np.ndarray:
     return np.array(_DP_B_HAT)
 
 
-_BY_NAME = {"euler": euler, "midpoint": midpoint, "rk2": midpoint, "heun": heun, "rk4": rk4,
-            "dopri5": dopri5}  # fmt: skip
+_BY_NAME = {"euler": euler, "midpoint": midpoint, "rk2": midpoint, "heun": heun, "rk3": rk3,
+            "kutta3": rk3, "heun3": heun3, "rk4": rk4, "dopri5": dopri5}  # fmt: skip
+
+
+def from_tableau(spec: dict, name: str = "custom") -> Scheme:
+    """A :class:`Scheme` from a mapping with ``A`` (s × s, strictly lower triangular), ``b``,
+    ``c`` and its ``order`` (checked against the order conditions), as study files and
+    ``stabdae integrate --tableau`` give it."""
+    missing = [k for k in ("A", "b", "c", "order") if k not in spec]
+    if missing:
+        raise SchemeError(f"a tableau needs A, b, c and order; missing {missing}")
+    try:
+        A = np.array(spec["A"], dtype=float)
+        b = np.array(spec["b"], dtype=float)
+        c = np.array(spec["c"], dtype=float)
+    except (TypeError, ValueError):
+        raise SchemeError("a tableau's A, b and c must be arrays of numbers") from None
+    return Scheme(str(spec.get("name", name)), A, b, c, int(spec["order"]), {})
 
 
 def as_scheme(scheme, **params) -> Scheme:

@@ -51,7 +51,7 @@ def _cmd_integrate(args) -> int:
     from .. import baumgarte, integrate, none
     from .._loading import load_model
     from .._schema import write_netcdf
-    from .._schemes import as_scheme
+    from .._schemes import as_scheme, from_tableau
     from ..theory import step_matrix
 
     model = load_model(args.model)
@@ -62,7 +62,17 @@ def _cmd_integrate(args) -> int:
         law = baumgarte(
             omega=args.omega if model.m else None, xi=args.xi, k=args.k if model.k else None
         )
-    scheme = as_scheme(args.scheme, **({"a": args.a, "sigma": args.sigma} if args.a else {}))
+    if args.tableau:
+        import json
+
+        try:
+            spec = json.loads(args.tableau)
+        except ValueError as exc:
+            raise ValueError(f"--tableau: not valid JSON: {exc}") from None
+        scheme = from_tableau(spec if isinstance(spec, dict) else {}, name="custom")
+    else:
+        scheme = as_scheme(args.scheme, **({"a": args.a, "sigma": args.sigma}
+                                           if args.a is not None else {}))  # fmt: skip
     rng = np.random.default_rng(args.seed)
     x_ref = model.reference_state(p)
     direction = rng.standard_normal(x_ref.shape)
@@ -208,7 +218,11 @@ def main(argv: list[str] | None = None) -> int:
     itg.add_argument("--omega", type=float, default=10.0)
     itg.add_argument("--xi", type=float, default=1.0)
     itg.add_argument("--k", type=float, default=10.0, help="gain of ḣ = −k h")
-    itg.add_argument("--scheme", default="rk2", help="euler | rk2 | midpoint | heun | rk4")
+    itg.add_argument("--scheme", default="rk2",
+                     help="euler | rk2 | midpoint | heun | rk3 | heun3 | rk4 | dopri5 | two_stage")
+    itg.add_argument("--tableau", metavar="JSON",
+                     help='your own explicit tableau, e.g. \'{"A": [[0, 0], [1, 0]], "b": [0.5, '
+                          '0.5], "c": [0, 1], "order": 2}\' (instead of --scheme)')
     itg.add_argument("--a", type=float, default=None, help="two-stage parameter a")
     itg.add_argument("--sigma", type=float, default=1.0, help="two-stage parameter sigma")
     itg.add_argument("--tau", type=float, default=1e-3)

@@ -23,7 +23,7 @@ import numpy as np
 from .._laws import Law, LawError, baumgarte, matrix, none, theorem5
 from .._loading import load_model, model_file
 from .._model import Model, ModelError
-from .._schemes import Scheme, SchemeError, as_scheme
+from .._schemes import Scheme, SchemeError, as_scheme, from_tableau
 from .._validate import block, fixed_time_grid
 
 __all__ = ["Study", "StudyError", "load_study"]
@@ -36,7 +36,8 @@ class StudyError(ValueError):
 _SECTIONS = {
     "model": {"file": str, "params": dict},
     "law": {"kind": str, "omega": float, "xi": float, "k": float, "A": list, "L": list},
-    "scheme": {"name": str, "a": float, "sigma": float},
+    "scheme": {"name": str, "a": float, "sigma": float, "A": list, "b": list, "c": list,
+               "order": int},
     "run": {"t_end": float, "tau": float, "save_dt": float, "epsilon": float,
             "divergence": float},  # fmt: skip
     "ensemble": {"members": int, "radius": (list, float), "seed": int, "block": int},
@@ -139,6 +140,8 @@ def _make_law(law: dict, A) -> Law:
 
 
 def _make_scheme(scheme: dict) -> Scheme:
+    if any(k in scheme for k in ("A", "b", "c", "order")):  # the user's own tableau
+        return from_tableau(scheme, name=scheme.get("name", "custom"))
     name = scheme.get("name", "rk2")
     params = {k: scheme[k] for k in ("a", "sigma") if k in scheme}
     return as_scheme(name, **params)
