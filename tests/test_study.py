@@ -231,3 +231,16 @@ def test_a_tableau_in_the_study_file(tmp_path):
     wrong = text.replace("order = 3", "order = 4")
     with pytest.raises(StudyError, match=r"\[scheme\] name: .*declared order 4"):
         load_study(write(tmp_path, wrong, "wrong.toml"))
+
+
+def test_moved_tau_values_are_reported(tmp_path, capsys):
+    """A swept τ that does not fit the sample grid is moved onto it, and the study says so
+    (printed by stabdae theory and stabdae run)."""
+    path = write(tmp_path, BASE + "\n[sweep]\ntau = [0.3, 0.0846, 0.01]\n")
+    study = load_study(path)
+    assert study.axes["run.tau"].tolist() == pytest.approx([0.25, 0.05, 0.01], rel=1e-12)
+    assert "0.3 → 0.25" in study.describe() and "0.0846 → 0.05" in study.describe()
+    assert "0.01 →" not in study.describe()
+    assert main(["theory", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "swept tau moved onto the sample grid" in out and "cond whether |R|P < 1" in out

@@ -140,6 +140,10 @@ def _cmd_theory(args) -> int:
               ", ".join(f"{k} {v:.6g}" for k, v in lims.items()))  # fmt: skip
     print("\nper grid point (R = R(τÃ); cond: the weighted-norm condition of Theorems 6/7):")
     print(format_table(ds))
+    print("\ncolumns: rho(R) spectral radius of R(τÃ); |R|max its max-norm (the paper's); "
+          "|R|P its norm in the\ndiscrete-Lyapunov weight; cond whether |R|P < 1 (Theorems "
+          "6/7); beta −max Re λ(Ã); beta_disc\n−ln rho(R)/τ; Lyap whether Theorem 4's "
+          "Lyapunov function exists; tau_lim the largest τ with\nrho(R) < 1")
     return 0
 
 
@@ -198,15 +202,18 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="stabdae",
         description="Stability of the constraint manifold under numerical integration.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"stabdae {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     chk = sub.add_parser("check", help="check a model's derivatives by finite differences")
     chk.add_argument("model", help="model file (.py) or built-in scene name")
-    chk.add_argument("--param", action="append", metavar="NAME=VALUE")
+    chk.add_argument("--param", action="append", metavar="NAME=VALUE",
+                     help="a parameter value instead of the model's default (repeatable)")
     chk.add_argument("--states", type=int, default=3, help="random states besides the reference")
-    chk.add_argument("--rtol", type=float, default=1e-6)
+    chk.add_argument("--rtol", type=float, default=1e-6,
+                     help="relative tolerance of the finite-difference comparison")
     chk.set_defaults(func=_cmd_check)
 
     itg = sub.add_parser(
@@ -214,9 +221,10 @@ def main(argv: list[str] | None = None) -> int:
         help="integrate one perturbed trajectory and compare its residual with the exact law",
     )
     itg.add_argument("model", nargs="?", default="pendulum", help="model file or scene name")
-    itg.add_argument("--law", choices=["baumgarte", "none"], default="baumgarte")
-    itg.add_argument("--omega", type=float, default=10.0)
-    itg.add_argument("--xi", type=float, default=1.0)
+    itg.add_argument("--law", choices=["baumgarte", "none"], default="baumgarte",
+                     help="the constraint-perturbation law")
+    itg.add_argument("--omega", type=float, default=10.0, help="Baumgarte's omega [s-1]")
+    itg.add_argument("--xi", type=float, default=1.0, help="Baumgarte's damping ratio xi")
     itg.add_argument("--k", type=float, default=10.0, help="gain of ḣ = −k h")
     itg.add_argument("--scheme", default="rk2",
                      help="euler | rk2 | midpoint | heun | rk3 | heun3 | rk4 | dopri5 | two_stage")
@@ -225,12 +233,14 @@ def main(argv: list[str] | None = None) -> int:
                           '0.5], "c": [0, 1], "order": 2}\' (instead of --scheme)')
     itg.add_argument("--a", type=float, default=None, help="two-stage parameter a")
     itg.add_argument("--sigma", type=float, default=1.0, help="two-stage parameter sigma")
-    itg.add_argument("--tau", type=float, default=1e-3)
-    itg.add_argument("--t-end", type=float, default=5.0)
-    itg.add_argument("--save-dt", type=float, default=0.05)
+    itg.add_argument("--tau", type=float, default=1e-3, help="step size [s]")
+    itg.add_argument("--t-end", type=float, default=5.0, help="final time [s]")
+    itg.add_argument("--save-dt", type=float, default=0.05,
+                     help="spacing of the stored samples [s], a multiple of --tau")
     itg.add_argument("--perturb", type=float, default=1e-3, help="size of the initial offset")
-    itg.add_argument("--seed", type=int, default=1)
-    itg.add_argument("--param", action="append", metavar="NAME=VALUE")
+    itg.add_argument("--seed", type=int, default=1, help="seed of the perturbation's direction")
+    itg.add_argument("--param", action="append", metavar="NAME=VALUE",
+                     help="a parameter value instead of the model's default (repeatable)")
     itg.add_argument("-o", "--output", help="NetCDF output path")
     itg.set_defaults(func=_cmd_integrate)
 
@@ -267,6 +277,8 @@ def main(argv: list[str] | None = None) -> int:
                      help="do not load and check the written model")  # fmt: skip
     gen.set_defaults(func=_cmd_generate)
 
+    for subparser in sub.choices.values():  # every option's help shows its default
+        subparser.formatter_class = argparse.ArgumentDefaultsHelpFormatter
     args = parser.parse_args(argv)
     try:
         return args.func(args)

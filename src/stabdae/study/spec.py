@@ -68,6 +68,8 @@ class Study:
     #: the model's file (resolved), whose content, with what it imports from its own
     #: folder, keys a run's parts
     model_file: Path | None = None
+    #: what validation changed and the user should know (printed with the description)
+    notes: list = field(default_factory=list)
 
     # ----------------------------------------------------------------- grid
     @property
@@ -123,9 +125,10 @@ class Study:
 
     def describe(self) -> str:
         axes = ", ".join(f"{k} ({len(v)})" for k, v in self.axes.items()) or "none"
-        return (f"study {self.path.name}: model {self.model.name}, law {self.law['kind']}, "
+        head = (f"study {self.path.name}: model {self.model.name}, law {self.law['kind']}, "
                 f"scheme {self.scheme.get('name', 'rk2')}, {self.ensemble['members']} members "
                 f"× {self.size} grid points; swept: {axes}")  # fmt: skip
+        return "\n".join([head, *self.notes])
 
 
 def _make_law(law: dict, A) -> Law:
@@ -254,6 +257,7 @@ def load_study(path, *, members: int | None = None) -> Study:
         fail("[ensemble] block", str(exc).removeprefix("study: "))
 
     # sweep
+    notes: list[str] = []
     axes = {}
     for name, spec in raw.get("sweep", {}).items():
         canon = _canonical(name, model, law, scheme, fail)
@@ -274,8 +278,15 @@ def load_study(path, *, members: int | None = None) -> Study:
         span = run["t_end"] - model.t0
         if "save_dt" not in run:
             run["save_dt"] = span / 200.0
-        axes["run.tau"] = snap_taus(axes["run.tau"], run["save_dt"], span, fail)
+        asked = axes["run.tau"]
+        axes["run.tau"] = snap_taus(asked, run["save_dt"], span, fail)
         run["tau"] = float(axes["run.tau"][0])
+        moved = [f"{a:g} → {b:g}" for a, b in zip(asked, axes["run.tau"])
+                 if abs(a - b) > 1e-12 * a]  # fmt: skip
+        if moved:
+            notes.append(f"note: swept tau moved onto the sample grid (save_dt = "
+                         f"{run['save_dt']:g}, every step a divisor of it or a multiple that "
+                         f"divides t_end): {', '.join(moved)}")  # fmt: skip
 
     output = raw.get("output", {}).get("path")
     if output is not None:  # a study file is data: it writes only beneath its own folder
@@ -287,7 +298,7 @@ def load_study(path, *, members: int | None = None) -> Study:
                   ensemble=ens, axes=axes,
                   output=None if output is None
                   else Path(os.path.normpath(path.parent / output)),
-                  model_file=model_file(source))  # fmt: skip
+                  model_file=model_file(source), notes=notes)  # fmt: skip
 
     # every grid point must build (law shapes, time grid): try them all, cheaply
     for _, values in study.points():
