@@ -187,3 +187,19 @@ def test_step_loop_allocates_nothing():
     finally:
         _nrt_python.memsys_disable_stats()
     assert counts[0] == counts[1] and counts[0] > 0
+
+
+def test_a_failed_write_names_the_file_and_the_free_space(tmp_path, monkeypatch):
+    """The HDF5 library reports a full disk as "NetCDF: HDF error": the message names the
+    file and the free space, and no temporary file is left."""
+    ds = stabdae.integrate(load_scene("pendulum"), None, stabdae.baumgarte(10.0), "rk4", 0.1,
+                           0.2)  # fmt: skip
+
+    def full_disk(*args, **kwargs):
+        raise RuntimeError("NetCDF: HDF error")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", full_disk)
+    with pytest.raises(OSError, match=r"could not write .*out\.nc: NetCDF: HDF error \(\d+ MiB "
+                                      r"free in .*a full disk reads like this\)"):  # fmt: skip
+        write_netcdf(ds, tmp_path / "out.nc")
+    assert list(tmp_path.iterdir()) == []

@@ -297,3 +297,22 @@ def test_force_and_bad_parts_are_computed_again(tmp_path, monkeypatch):
     out = run_study(study, force=True, progress=False, log=said.append)
     assert f"--force: discarding {parts}" in said
     same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
+
+
+def test_a_second_run_on_the_same_output_is_refused_while_the_first_lives(tmp_path):
+    """Two runs writing one output would remove each other's parts: the parts folder is
+    locked by the process that runs it, and a lock left by a dead process is taken over."""
+    study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
+    parts = tmp_path / "out" / "study.nc.parts"
+    parts.mkdir(parents=True)
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        (parts / "lock").write_text(f"{sleeper.pid} somehost\n")
+        with pytest.raises(FileExistsError, match=rf"being written by another stabdae run "
+                                                  rf"\(process {sleeper.pid}\)"):  # fmt: skip
+            run_study(study, progress=False, log=lambda *a: None)
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    out = run_study(study, progress=False, log=lambda *a: None)  # the holder is gone
+    assert out.is_file() and not parts.exists()

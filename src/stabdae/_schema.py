@@ -20,6 +20,7 @@ from __future__ import annotations
 import datetime as _dt
 import os
 import re
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -380,7 +381,14 @@ def write_netcdf(ds: xr.Dataset, path, *, compress: int = 4, overwrite: bool = T
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
-        ds.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
+        try:
+            ds.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
+        except (OSError, RuntimeError) as exc:  # the HDF5 library says "HDF error", no more
+            free = shutil.disk_usage(path.parent).free
+            raise OSError(
+                f"could not write {path}: {exc} ({free / 2**20:.0f} MiB free in "
+                f"{path.parent}: a full disk reads like this)"
+            ) from exc
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file ordinary modes

@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import shutil
+import socket
 import sys
 import time
 import warnings
@@ -155,24 +157,78 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     stamp = _fingerprint(study)
     manifest = parts / "study.json"
     log(study.describe())
-    if parts.exists() and force:
-        log(f"--force: discarding {parts}")
-        shutil.rmtree(parts)
-    elif parts.exists():
-        try:
-            old = json.loads(manifest.read_text())
-        except (OSError, ValueError):
-            old = {}
-        if old.get("study") != str(study.path):
-            raise FileExistsError(
-                f"{parts} holds a run of a different study "
-                f"({old.get('study', 'unknown')}); pass --force to discard it"
-            )
-        if old.get("fingerprint") != stamp:
-            log(f"the study file, its model or the library changed since {parts} was "
-                "written: starting over")  # fmt: skip
-            shutil.rmtree(parts)
+    existed = parts.exists() and any(p.name != "lock" for p in parts.iterdir())
     parts.mkdir(parents=True, exist_ok=True)
+    lock = _lock(parts)  # first: nothing below may remove another live run's parts
+    try:
+        if existed and force:
+            log(f"--force: discarding {parts}")
+            _clear(parts, lock)
+        elif existed:
+            try:
+                old = json.loads(manifest.read_text())
+            except (OSError, ValueError):
+                old = {}
+            if old.get("study") != str(study.path):
+                raise FileExistsError(
+                    f"{parts} holds a run of a different study "
+                    f"({old.get('study', 'unknown')}); pass --force to discard it"
+                )
+            if old.get("fingerprint") != stamp:
+                log(f"the study file, its model or the library changed since {parts} was "
+                    "written: starting over")  # fmt: skip
+                _clear(parts, lock)
+        return _run_locked(study, out, parts, stamp, manifest, workers, scheduler, progress,
+                           threads, log)  # fmt: skip
+    finally:
+        lock.unlink(missing_ok=True)
+        if parts.exists() and not any(parts.iterdir()):
+            parts.rmdir()
+
+
+def _clear(parts: Path, keep: Path) -> None:
+    for path in parts.iterdir():
+        if path != keep:
+            shutil.rmtree(path) if path.is_dir() else path.unlink()
+
+
+def _lock(parts: Path) -> Path:
+    """Take ``parts/lock`` for this process; refuse when a live process holds it (two runs
+    writing one output would remove each other's parts), take over a dead one's."""
+    lock = parts / "lock"
+    for _ in range(2):
+        try:
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            try:
+                pid = int(lock.read_text().split()[0])
+            except (OSError, ValueError, IndexError):
+                pid = None
+            if pid is not None and pid != os.getpid() and _alive(pid):
+                raise FileExistsError(
+                    f"{parts} is being written by another stabdae run (process {pid}); wait "
+                    f"for it to finish, or remove {lock} if that process is gone"
+                ) from None
+            lock.unlink(missing_ok=True)  # left by a run that died
+            continue
+        with os.fdopen(fd, "w") as f:
+            f.write(f"{os.getpid()} {socket.gethostname()}\n")
+        return lock
+    raise FileExistsError(f"could not take {lock}")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process
+        return True
+    return True
+
+
+def _run_locked(study, out, parts, stamp, manifest, workers, scheduler, progress, threads,
+                log) -> Path:  # fmt: skip
     manifest.write_text(json.dumps({"fingerprint": stamp, "study": str(study.path)}))
 
     points = list(study.points())

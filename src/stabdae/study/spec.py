@@ -270,6 +270,9 @@ def load_study(path, *, members: int | None = None) -> Study:
         if size > MAX_POINTS:
             fail("[sweep]", f"{size:.3g} grid points: at most {MAX_POINTS} (one ensemble each)")
 
+    if "run.tau" not in axes and "save_dt" in run and run["tau"] > run["save_dt"] * (1 + 1e-12):
+        notes.append(f"note: tau = {run['tau']:g} is larger than save_dt = "
+                     f"{run['save_dt']:g}: samples between two steps are NaN")  # fmt: skip
     for key in ("a", "sigma"):  # the base point of a two-stage sweep: its first value
         if f"scheme.{key}" in axes:
             scheme.setdefault(key, float(axes[f"scheme.{key}"][0]))
