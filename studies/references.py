@@ -15,6 +15,23 @@ ANDREWS_T003 = np.array([
     -0.5347301163226948e0, 0.5244099658805304e0, 0.5347301163226948e0,
     0.1048080741042263e1,
 ])  # fmt: skip
+#: the rest of andsoln at t = 0.03: velocities y(8..14), accelerations y(15..21) and the
+#: multipliers y(22..27).  The Test Set writes M q'' = f(q, q') - G^T lambda; stabdae writes
+#: M v' = F^T lambda - gamma with gamma = -f, so its lambda is minus these.
+ANDREWS_T003_VELOCITY = np.array([
+    0.1139920302151208e4, -0.1424379294994111e4, 0.1103291221937134e2,
+    0.1929337464421385e2, 0.5735699284790808e0, -0.1929337464421385e2,
+    0.3231791658026955e0,
+])  # fmt: skip
+ANDREWS_T003_ACCELERATION = np.array([
+    -0.2463176316945196e5, 0.5185037701610329e5, 0.3241025686413781e6,
+    0.5667493645176213e6, 0.1674362929479361e5, -0.5667493645176222e6,
+    0.9826520791458422e4,
+])  # fmt: skip
+ANDREWS_T003_LAMBDA = np.array([
+    0.1991753333731910e3, -0.2975531228015052e2, 0.2306654119098399e2,
+    0.3145271365475927e2, 0.2264249232082739e2, 0.1161740700019673e2,
+])  # fmt: skip
 #: Test Set reference of the car axis at t = 3: positions, then velocities (carsoln)
 CAR_AXIS_T3 = np.array([
     0.4934557842755629e-1, 0.4969894602303324e0, 0.1041742524885400e1,

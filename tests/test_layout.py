@@ -240,6 +240,7 @@ def test_every_dataset_has_valid_units_history_and_one_time_format(tmp_path):
     datasets = [
         traj,
         stabdae.integrate_adaptive(pend, None, law, 0.2, rtol=1e-6, save_dt=0.1),
+        stabdae.integrate(pend, None, law, "rk4", 0.01, 0.2, 0.1, with_multipliers=True),
         stabdae.ensemble(pend, law, "midpoint", 0.01, 0.2, members=8),
         stabdae.ensemble(pend, law, tau=0.01, t_end=0.2, rtol=1e-6, members=4),
         stabdae.ensemble(sleigh, stabdae.theorem5(2.0), "rk4", 0.01, 0.2, members=4),
@@ -252,11 +253,11 @@ def test_every_dataset_has_valid_units_history_and_one_time_format(tmp_path):
     datasets.append(for_study(load_study(study)))
     for ds in datasets:
         assert_schema(ds)
-    ens = datasets[2]
+    ens = datasets[3]
     assert ens.residual_norm.attrs["units_per_component"] == "component_units"
     assert ens.beta.attrs["units"] == "s-1"
     # a model whose constraints share one unit: the norms carry it
-    sl = datasets[4]
+    sl = datasets[5]
     assert sl.residual_norm.attrs["units"] == "m s-1" and sl.gamma.attrs["units"] == "m s-1"
 
 

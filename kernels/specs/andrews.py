@@ -83,6 +83,7 @@ system = System(
     energy=False,  # the torque does work; there is no first integral to check
     coordinate_units=["rad"] * 7,
     constraint_units=["m"] * 6,
+    energy_units="J",
     simplify=False,  # 7×7 with trigonometry: expansion and CSE suffice
     description=__doc__,
 )

@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 
 from . import _validate as check
-from ._integrate import IntegrationWarning
+from ._integrate import IntegrationWarning, _multipliers
 from ._model import Model
 from ._schema import trajectory_dataset
 from ._schemes import dopri5, dopri5_embedded_weights
@@ -36,6 +36,7 @@ def integrate_adaptive(
     t0: float | None = None,
     multiplier: str = "ldl",
     projection: str | None = None,
+    with_multipliers: bool = False,
 ):
     """Integrate one trajectory of the stabilized equations with Dormand–Prince 5(4).
 
@@ -62,6 +63,10 @@ def integrate_adaptive(
     t0 : float, optional
     multiplier : {"ldl", "lstsq"}
         As for :func:`stabdae.integrate`: ``"lstsq"`` integrates redundant constraints.
+    with_multipliers : bool, default False
+        Also store the multipliers λ of (3.11) (``multiplier(time, constraint)``, with
+        ``M v̇ = Fᵀλ − γ``) and the accelerations ``acceleration(time, coordinate)`` at the
+        stored samples, for comparison with published λ and index-2 references.
     projection : {None, "post", "full"}
         As for :func:`stabdae.integrate`, after each accepted step (costs one more
         right-hand-side evaluation per step: the first-same-as-last stage is lost).
@@ -128,6 +133,8 @@ def integrate_adaptive(
              steps=int(counts[0]), multiplier=multiplier,
              projection=str(projection).lower()),
         action="integrate_adaptive",
+        multipliers=_multipliers(model, bound, multiplier, times, out_x, p)
+        if with_multipliers else None,
     )  # fmt: skip
     ds.attrs.update(
         steps_accepted=int(counts[0]), steps_rejected=int(counts[1]),

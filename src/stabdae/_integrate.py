@@ -11,7 +11,7 @@ from . import _validate as check
 from ._model import Model
 from ._schema import trajectory_dataset
 from ._status import Status
-from .kernels.steps import integrator_for
+from .kernels.steps import integrator_for, multipliers_for
 
 __all__ = ["integrate", "IntegrationWarning"]
 
@@ -33,6 +33,7 @@ def integrate(
     t0: float | None = None,
     multiplier: str = "ldl",
     projection: str | None = None,
+    with_multipliers: bool = False,
 ) -> xr.Dataset:
     """Integrate one trajectory of the stabilized equations (3.1), (3.11).
 
@@ -62,6 +63,10 @@ def integrate(
         How λ is solved from (3.11): ``"ldl"`` factorizes ``S`` and stops with status
         ``SINGULAR_S`` when it is singular (redundant constraints); ``"lstsq"`` takes the
         minimum-norm least-squares λ (pseudo-inverse of ``S``) and keeps integrating.
+    with_multipliers : bool, default False
+        Also store the multipliers λ of (3.11) (``multiplier(time, constraint)``, with
+        ``M v̇ = Fᵀλ − γ``) and the accelerations ``acceleration(time, coordinate)`` at the
+        stored samples, for comparison with published λ and index-2 references.
     projection : {None, "post", "full"}
         After each step: ``"post"`` applies one post-stabilization sweep
         ``x ← x − D (G D)⁻¹ g(x)`` (positions, then velocities; Ascher et al.'s block
@@ -119,4 +124,15 @@ def integrate(
         dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every, steps=nsteps,
              multiplier=multiplier, projection=str(projection).lower()),
         action="integrate",
+        multipliers=_multipliers(model, bound, multiplier, times, out_x, p)
+        if with_multipliers else None,
     )  # fmt: skip
+
+
+def _multipliers(model, bound, multiplier, times, xs, p):
+    """``(λ, v̇)`` at the stored states (NaN where a state is not finite)."""
+    lam = np.full((xs.shape[0], model.r), np.nan)
+    acc = np.full((xs.shape[0], model.n), np.nan)
+    multipliers_for(model, bound, multiplier)(np.ascontiguousarray(times), xs, p,
+                                              bound.matrix, bound.scalars, lam, acc)  # fmt: skip
+    return lam, acc

@@ -86,7 +86,8 @@ class Model:
         ``h`` (default ``"1"``, dimensionless); ``ḟ`` gets ``"<unit> s-1"``.  Datasets
         label the residual components, and the norms of the residual, with them.
     energy_units : str, optional
-        UDUNITS units of ``energy`` (default ``"1"``).
+        UDUNITS units of energy (default ``"1"``): of ``energy``, and the numerator of the
+        multipliers' units (λ is energy per constraint unit).
     mass, forces, f, f_q, f_t, f_accel, h, h_q, h_v, h_t, energy : numba dispatchers
         The pieces of the model; see the module docstring for signatures.  ``forces`` is
         required; the constraint pieces follow from ``m`` and ``k``; ``mass`` (identity
@@ -215,6 +216,27 @@ class Model:
         """Units of the residual components ``(f, ḟ, h)``."""
         f_units = list(self.constraint_units[: self.m])
         return f_units + [_per_second(u) for u in f_units] + list(self.constraint_units[self.m:])
+
+    @property
+    def multiplier_names(self) -> list[str]:
+        """The constraint each multiplier λ belongs to: ``f_i``, then ``h_j``."""
+        return [f"f_{i}" for i in range(self.m)] + [f"h_{j}" for j in range(self.k)]
+
+    @property
+    def multiplier_units(self) -> list[str]:
+        """Units of λ: energy per constraint unit (``Fᵀλ`` is a generalized force); a
+        velocity constraint's row of F is ∂h/∂v, so there per constraint unit and second."""
+        from ._schema import units_quotient
+
+        cu = self.constraint_units
+        return ([units_quotient(self.energy_units, u) for u in cu[: self.m]]
+                + [units_quotient(self.energy_units, f"{u} s") for u in cu[self.m:]])  # fmt: skip
+
+    @property
+    def acceleration_units(self) -> list[str]:
+        from ._schema import units_quotient
+
+        return [units_quotient(u, "s2") for u in self.coordinate_units]
 
     @property
     def component_names(self) -> list[str]:

@@ -38,6 +38,7 @@ __all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "prov
 #: units markers resolved per model: the state's, the residual components', the residual
 #: norm's (the constraints' common unit), the energy's
 STATE, COMPONENT, RESIDUAL, ENERGY = "@state", "@component", "@residual", "@energy"
+MULTIPLIER, ACCELERATION = "@multiplier", "@acceleration"
 
 _FLAG = {"flag_values": [0, 1], "flag_meanings": "no yes"}
 _HELD = {**_FLAG, "comment": "judged above 10x the member's residual floor, that floor added "
@@ -51,6 +52,9 @@ SCHEMA: dict[str, tuple] = {
     "residual": (("time", "component"), "constraint residual g = (f, fdot, h) (3.2)",
                  COMPONENT, {}),
     "energy": ("time", "energy (model's energy function)", ENERGY, {}),
+    "multiplier": (("time", "constraint"), "Lagrange multipliers lambda of (3.11): "
+                   "M dv/dt = F^T lambda - gamma", MULTIPLIER, {}),
+    "acceleration": (("time", "coordinate"), "acceleration dv/dt", ACCELERATION, {}),
     # --- an ensemble (and, per grid point, a study)
     "residual_norm": (("member", "time"), "max-norm of the constraint residual", RESIDUAL,
                       {"comment": "NaN after a member stopped"}),
@@ -128,8 +132,9 @@ SCHEMA: dict[str, tuple] = {
 
 #: the datasets each variable appears in (for the generated reference page)
 _GROUPS = (
-    ("One trajectory: `integrate`, `integrate_adaptive`", ("x", "residual", "residual_norm",
-                                                            "energy")),
+    ("One trajectory: `integrate`, `integrate_adaptive` (`multiplier`, `acceleration` with "
+     "`with_multipliers=True`)", ("x", "residual", "residual_norm", "energy", "multiplier",
+                                  "acceleration")),
     ("An ensemble: `ensemble` (and per grid point, `stabdae run`)", (
         "residual_norm", "alpha0", "alpha0_norm", "x0", "x_final", "beta", "gamma",
         "residual_floor", "max_residual", "bounded", "diverged", "diverged_step", "status",
@@ -155,6 +160,8 @@ _MARKER_TEXT = {
     COMPONENT: "per residual component (`component_units`)",
     RESIDUAL: "the constraints' unit (per component where they differ)",
     ENERGY: "the model's `energy_units`",
+    MULTIPLIER: "per constraint (`multiplier_units`: energy per constraint unit)",
+    ACCELERATION: "per coordinate (`acceleration_units`)",
 }
 
 
@@ -235,6 +242,10 @@ def _resolve_units(marker: str, model) -> dict:
         return extra
     if marker == ENERGY:
         return {"units": getattr(model, "energy_units", "1")}
+    if marker in (MULTIPLIER, ACCELERATION):
+        coord = "multiplier_units" if marker == MULTIPLIER else "acceleration_units"
+        common = _common(getattr(model, coord)) if model is not None else None
+        return {"units": common} if common else {"units_per_component": coord}
     return {"units": marker}
 
 
@@ -269,6 +280,35 @@ def component_coords(model) -> dict:
         ),
         "component_units": variable("component", model.component_units,
                                     "units of each residual component", None),
+    }  # fmt: skip
+
+
+def units_quotient(numerator: str, denominator: str) -> str:
+    """``numerator / denominator`` as a product of UDUNITS factors with integer powers
+    (``"J", "m s-1" -> "J m-1 s"``)."""
+    powers: dict[str, int] = {}
+    for text, sign in ((numerator, 1), (denominator, -1)):
+        for factor in re.split(r"[\s.*]+", text.strip()):
+            m = _FACTOR.match(factor)
+            if m is None or m.group(1) == "1":
+                continue
+            powers[m.group(1)] = powers.get(m.group(1), 0) + sign * int(m.group(2) or 1)
+    out = [f"{u}{'' if k == 1 else k}" for u, k in powers.items() if k]
+    return " ".join(out) or "1"
+
+
+def mechanics_coords(model) -> dict:
+    """The coordinates and constraints, and the units of the accelerations and
+    multipliers, for the optional ``acceleration`` and ``multiplier`` variables."""
+    return {
+        "coordinate": variable("coordinate", list(model.coordinates), "generalized coordinate",
+                               None),
+        "acceleration_units": variable("coordinate", model.acceleration_units,
+                                       "units of each acceleration", None),
+        "constraint": variable("constraint", model.multiplier_names,
+                               "constraint of each multiplier (f_i, then h_j)", None),
+        "multiplier_units": variable("constraint", model.multiplier_units,
+                                     "units of each multiplier", None),
     }  # fmt: skip
 
 
@@ -346,8 +386,9 @@ def provenance(model, p: np.ndarray | None, law, scheme, action: str, **run) -> 
 
 # --------------------------------------------------------------------- datasets
 def trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, run, *,
-                       action: str) -> xr.Dataset:  # fmt: skip
-    """The dataset of one trajectory: ``x``, ``residual``, ``residual_norm``, ``energy``."""
+                       action: str, multipliers=None) -> xr.Dataset:  # fmt: skip
+    """The dataset of one trajectory: ``x``, ``residual``, ``residual_norm``, ``energy``, and
+    with ``multipliers = (λ, v̇)`` also ``multiplier`` and ``acceleration``."""
     data = {
         "x": schema_variable("x", xs, model),
         "residual": schema_variable("residual", gs, model),
@@ -357,11 +398,16 @@ def trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, r
     data["residual_norm"].attrs["comment"] = "NaN after a stop"
     if model.energy is not None:
         data["energy"] = schema_variable("energy", es, model)
+    coords = model_coords(model, times)
+    if multipliers is not None:
+        data["multiplier"] = schema_variable("multiplier", multipliers[0], model)
+        data["acceleration"] = schema_variable("acceleration", multipliers[1], model)
+        coords.update(mechanics_coords(model))
     attrs = provenance(model, p, law, scheme, f"{action}: one trajectory", **run)
     status = Status(status)
     attrs.update(status=int(status), status_name=status.name.lower(), steps_completed=done)
     attrs.update({f"status_{k}": v for k, v in status_flag_attrs().items()})
-    return xr.Dataset(data, coords=model_coords(model, times), attrs=attrs)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 def write_netcdf(ds: xr.Dataset, path, *, compress: int = 4, overwrite: bool = True) -> Path:

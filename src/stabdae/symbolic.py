@@ -383,7 +383,7 @@ class System:
             units = getattr(self, name)
             if units:
                 args.append(f"{name}=[" + ", ".join(map(_quote, units)) + "]")
-        if self.energy_units is not None and self.energy_spec is not False:
+        if self.energy_units is not None:  # (also without an energy: λ is energy/constraint)
             args.append(f"energy_units={_quote(self.energy_units)}")
         args += [f"{piece}={piece}" for piece in pieces]
         if self.t0:

@@ -20,7 +20,7 @@ from .cache import kernel_key, keyed_cache, memo
 from .fma import fma
 from .rhs import kernels_for
 
-__all__ = ["Stepper", "integrator_for", "sample_writer", "stepper_for"]
+__all__ = ["Stepper", "integrator_for", "multipliers_for", "sample_writer", "stepper_for"]
 
 _NONFINITE = int(Status.NONFINITE_STATE)
 
@@ -128,3 +128,38 @@ def _build_stepper(K):
     keyed_cache(step, kernel_key(K.key, "step"))
     keyed_cache(integrate_kernel, kernel_key(K.key, "integrate"))
     return Stepper(step, integrate_kernel)
+
+
+def multipliers_for(model, bound, multiplier: str = "ldl"):
+    """``kernel(times, xs, p, law_mat, law_scal, out_lam, out_acc)``: the multipliers λ of
+    (3.11) and the accelerations v̇ at stored states (memoized on the model)."""
+    return memo(model, ("multipliers", bound.code, bound.fn, multiplier),
+                lambda: _build_multipliers(kernels_for(model, bound, multiplier)))  # fmt: skip
+
+
+def _build_multipliers(K):
+    rhs, make_workspace = K.rhs, K.make_workspace
+    n, r, N2 = K.n, K.m + K.k, 2 * K.n
+
+    @njit(error_model="numpy")
+    def multipliers(times, xs, p, law_mat, law_scal, out_lam, out_acc):
+        """Row ``j``: λ (the right side of (3.11) after the solve) and v̇ at state
+        ``xs[j]``, time ``times[j]``; rows of non-finite states are left as they are."""
+        ws = make_workspace()
+        x = np.empty(N2)
+        xdot = np.empty(N2)
+        for j in range(xs.shape[0]):
+            finite = True
+            for l in range(N2):
+                x[l] = xs[j, l]
+                finite &= math.isfinite(x[l])
+            if not finite:
+                continue
+            if rhs(times[j], x, p, law_mat, law_scal, ws, xdot) != 0:
+                continue
+            for i in range(r):
+                out_lam[j, i] = ws.rl[i]
+            for i in range(n):
+                out_acc[j, i] = xdot[n + i]
+
+    return keyed_cache(multipliers, kernel_key(K.key, "multipliers"))
