@@ -39,6 +39,16 @@ def test_getting_started_runs(tmp_path, monkeypatch, capsys):
     assert 1e-6 < float(ens.residual_floor.median()) < 1e-5
     norms = ds.residual_norm.values
     assert norms[20] < 1e-2 * norms[0] and 1e-6 < norms[-1] < 1e-5  # decayed to the floor
+    # the numbers the page quotes, read from the page
+    page = (DOCS / "getting-started.md").read_text()
+    quoted = re.search(r"fall from (\S+) to (\S+) and (\S+), then stay near (\S+):", page)
+    for value, text in zip(norms[[0, 10, 20, 40]], quoted.groups()):
+        digits = len(text.split("e")[0].replace(".", ""))  # as many digits as quoted
+        assert f"{value:.{digits - 1}e}".replace("e-0", "e-") == text, (value, text)
+    about = re.search(r"# about ([\d.]+) and ([\d.]+)", page).groups()
+    assert f"{float(ens.beta_median):.3g}" == about[0], (float(ens.beta_median), about)
+    floor = re.search(r"the truncation floor, about (\S+)", page).group(1)
+    assert f"{float(ens.residual_floor.median()):.0e}".replace("e-0", "e-") == floor
     assert (tmp_path / "pendulum_ensemble.nc").is_file()
 
 

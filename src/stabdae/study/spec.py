@@ -292,11 +292,12 @@ def load_study(path, *, members: int | None = None) -> Study:
                          f"divides t_end): {', '.join(moved)}")  # fmt: skip
 
     output = raw.get("output", {}).get("path")
-    if output is not None:  # a study file is data: it writes only beneath its own folder
-        rel = Path(output)
-        if rel.is_absolute() or ".." in rel.parts or not rel.parts:
-            fail("[output] path", f"must be a relative path beneath the study's folder, got "
-                 f"{output!r} (give another place with stabdae run -o)")  # fmt: skip
+    if output is not None:  # a study file is data: it writes beneath its folder or here
+        target = Path(os.path.normpath(path.parent.resolve() / output))
+        if not any(target.is_relative_to(base) and target != base
+                   for base in (path.parent.resolve(), Path.cwd().resolve())):  # fmt: skip
+            fail("[output] path", f"must lie beneath the study's folder or the current one, "
+                 f"got {output!r} (give another place with stabdae run -o)")  # fmt: skip
     study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
                   ensemble=ens, axes=axes,
                   output=None if output is None
