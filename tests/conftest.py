@@ -52,6 +52,24 @@ def scene_module(name: str):
     return sys.modules[key]
 
 
+def rhs_function(model: stabdae.Model, law):
+    """The stabilized right-hand side ``F(t, x)`` of ``model`` under ``law`` as a Python
+    function (the compiled one, called directly), for tests against its definition."""
+    from stabdae._laws import bind_law
+    from stabdae.kernels.rhs import kernels_for
+
+    bound = bind_law(law, model)
+    K = kernels_for(model, bound)
+    ws, p = K.make_workspace(), model.param_vector()
+
+    def F(t, x):
+        out = np.empty_like(x)
+        assert K.rhs(t, x, p, bound.matrix, bound.scalars, ws, out) == 0
+        return out
+
+    return F
+
+
 def perturbed_state(model: stabdae.Model, size: float, seed: int = 0) -> np.ndarray:
     """The reference state displaced by ``size`` (relative) in a seeded random direction."""
     rng = np.random.default_rng(seed)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import stabdae
-from conftest import CONSERVATIVE, HARD, SCENES, load_scene, scene_module
+from conftest import CONSERVATIVE, HARD, SCENES, load_scene, rhs_function, scene_module
 
 T_END = 1.0
 SCHEMES = {
@@ -91,20 +91,9 @@ def test_heun_step_is_heuns_map_of_the_right_hand_side(tau):
     k₁ = F(t₀, x₀), k₂ = F(t₀ + τ, x₀ + τk₁), on a time-dependent model (F the stabilized
     right-hand side, called directly).  Any other second-order two-stage scheme (Ralston's
     a = 2/3, σ = 3/4, say) differs from it at order τ³."""
-    from stabdae._laws import bind_law
-    from stabdae.kernels.rhs import kernels_for
-
     model = load_scene("pendulum_varying_length")
     law = stabdae.baumgarte(5.0, 1.0)
-    bound = bind_law(law, model)
-    K = kernels_for(model, bound)
-    ws, p = K.make_workspace(), model.param_vector()
-
-    def F(t, x):
-        out = np.empty_like(x)
-        assert K.rhs(t, x, p, bound.matrix, bound.scalars, ws, out) == 0
-        return out
-
+    F = rhs_function(model, law)
     t0 = 0.3
     x0 = model.reference_state() + 1e-3
     ds = stabdae.integrate(model, x0, law, "heun", tau, t0 + tau, tau, t0=t0)

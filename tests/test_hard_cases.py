@@ -14,7 +14,7 @@ import pytest
 from scipy.linalg import expm
 
 import stabdae
-from conftest import ROOT, load_file, load_scene
+from conftest import ROOT, load_file, load_scene, rhs_function
 
 _refs = load_file(ROOT / "studies" / "references.py", "stabdae_study_references")
 ANDREWS_T003, CAR_AXIS_T3, digits = _refs.ANDREWS_T003, _refs.CAR_AXIS_T3, _refs.digits
@@ -250,20 +250,9 @@ def test_adaptive_loop_takes_scipy_rk45s_steps(rtol):
     and end at the same state to roundoff."""
     from scipy.integrate import solve_ivp
 
-    from stabdae._laws import bind_law
-    from stabdae.kernels.rhs import kernels_for
-
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)
-    bound = bind_law(law, model)
-    K = kernels_for(model, bound)
-    ws, p = K.make_workspace(), model.param_vector()
-
-    def F(t, x):
-        out = np.empty_like(x)
-        assert K.rhs(t, x, p, bound.matrix, bound.scalars, ws, out) == 0
-        return out
-
+    F = rhs_function(model, law)
     x0 = model.reference_state() + 1e-3
     ref = solve_ivp(F, (0.0, 10.0), x0, method="RK45", rtol=rtol, atol=rtol)
     ds = stabdae.integrate_adaptive(model, x0, law, 10.0, rtol=rtol, atol=rtol)

@@ -208,11 +208,12 @@ def test_tau_limit_lies_just_on_the_stable_side_of_the_exact_limit(scheme):
     A = np.array([[-k]])
     z = 2.785293563405282 if scheme == "rk4" else 2.0
     exact = z / k
-    lim = theory.tau_limit(A, scheme, rtol=1e-10)
-    assert exact * (1 - 2e-10) <= lim < exact
+    for condition in ("spectral", "max_norm", "two_norm", "weighted_norm"):  # equal: scalar
+        lim = theory.tau_limit(A, scheme, condition, rtol=1e-10)
+        assert exact * (1 - 2e-10) <= lim < exact, condition
+        assert theory.tau_limit(A, scheme, condition, tau_max=0.5 * exact) == math.inf
     assert theory.spectral_radius(theory.step_matrix(A, scheme, lim)) < 1.0
     assert theory.spectral_radius(theory.step_matrix(A, scheme, exact * (1 + 1e-9))) > 1.0
-    assert theory.tau_limit(A, scheme, tau_max=0.5 * exact) == math.inf
 
 
 @pytest.mark.parametrize("scene", ["pendulum", "double_pendulum"])
