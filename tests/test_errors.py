@@ -215,8 +215,8 @@ def test_law_errors():
 
 
 def test_scheme_errors():
-    with pytest.raises(stabdae.SchemeError, match=r"unknown scheme 'rk3'"):
-        stabdae.integrate(build(), None, stabdae.none(), "rk3", 0.1, 1.0)
+    with pytest.raises(stabdae.SchemeError, match=r"unknown scheme 'rk5'"):
+        stabdae.integrate(build(), None, stabdae.none(), "rk5", 0.1, 1.0)
     with pytest.raises(stabdae.SchemeError, match=r"got the function stabdae.midpoint; call it"):
         stabdae.integrate(build(), None, stabdae.none(), stabdae.midpoint, 0.1, 1.0)
     with pytest.raises(stabdae.SchemeError, match=r"declared order 2 but .* up to order 1"):

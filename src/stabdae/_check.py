@@ -144,24 +144,12 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
     return report
 
 
-def _probe_state(model: Model, i: int, x, t: float, p) -> None:
-    """Every piece run at state ``i`` first as Python, with NumPy's bounds checks: a write
-    outside ``out`` that the reference state did not reach raises a ModelError naming the
-    piece and the state, instead of corrupting memory in the compiled kernels."""
-    from ._model import _PIECES, _call_signature, probe_output
-
-    q, v = np.ascontiguousarray(x[: model.n]), np.ascontiguousarray(x[model.n :])
-    for piece, fn in model.functions.items():
-        pattern, shape_of, governs = _PIECES[piece]
-        args = (float(t), q, p) if pattern == "tqp" else (float(t), q, v, p)
-        probe_output(f"Model {model.name!r}: {_call_signature(piece)} at check state {i}",
-                     fn, args, shape_of(model.n, model.m, model.k),
-                     f"{governs} from n={model.n}, m={model.m}, k={model.k}")  # fmt: skip
-
-
 def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> None:
-    """Append the rows of state ``i`` to ``report``."""
-    _probe_state(model, i, x, t, p)
+    """Append the rows of state ``i`` to ``report``; first every piece runs there as
+    Python, with NumPy's bounds checks: a write outside ``out`` that the reference state
+    did not reach raises a ModelError naming the piece and the state, instead of corrupting
+    memory in the compiled kernels."""
+    model._probe_at(t, x, p, f" at check state {i}")
     n, ev = model.n, model.evaluate
     q, v = x[:n], x[n:]
 

@@ -430,18 +430,27 @@ class Model:
     def _probe_all(self, x: np.ndarray, p: np.ndarray) -> None:
         q, v = x[: self.n].copy(), x[self.n :].copy()
         t = self.t0
+        outputs = self._probe_at(t, x, p)
+        if "mass" in outputs:
+            self._check_symmetric(outputs["mass"])
+        if self.energy is not None:
+            self._probe_energy(t, q, v, p)
+
+    def _probe_at(self, t: float, x: np.ndarray, p: np.ndarray, where: str = "") -> dict:
+        """Run every piece at ``(t, x)`` through :func:`probe_output` (first as Python, with
+        NumPy's bounds checks); returns the outputs by piece.  ``where`` is added to the
+        messages ("at check state 3")."""
+        q, v = np.ascontiguousarray(x[: self.n]), np.ascontiguousarray(x[self.n :])
+        outputs = {}
         for piece, fn in self.functions.items():
             pattern, shape_of, governs = _PIECES[piece]
-            args = (t, q, p) if pattern == "tqp" else (t, q, v, p)
-            out = probe_output(
-                f"Model {self.name!r}: {_call_signature(piece)}",
+            args = (float(t), q, p) if pattern == "tqp" else (float(t), q, v, p)
+            outputs[piece] = probe_output(
+                f"Model {self.name!r}: {_call_signature(piece)}{where}",
                 fn, args, shape_of(self.n, self.m, self.k),
                 f"{governs} from n={self.n}, m={self.m}, k={self.k}",
             )  # fmt: skip
-            if piece == "mass":
-                self._check_symmetric(out)
-        if self.energy is not None:
-            self._probe_energy(t, q, v, p)
+        return outputs
 
     def _check_symmetric(self, M: np.ndarray) -> None:
         """The kernels factor M by L D Lᵀ from its lower triangle alone: an asymmetric
