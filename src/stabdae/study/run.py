@@ -151,16 +151,16 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     if out.exists() and not _is_stabdae_dataset(out):
         raise FileExistsError(f"{out} exists and is not a stabdae dataset; it is not replaced "
                               "(give another output with -o)")  # fmt: skip
-    for orphan in out.parent.glob(f".{out.name}.*.tmp"):  # left by a write that was killed
-        orphan.unlink(missing_ok=True)
     parts = out.with_name(out.name + ".parts")
     stamp = _fingerprint(study)
     manifest = parts / "study.json"
     log(study.describe())
     existed = parts.exists() and any(p.name != "lock" for p in parts.iterdir())
     parts.mkdir(parents=True, exist_ok=True)
-    lock = _lock(parts)  # first: nothing below may remove another live run's parts
+    lock = _lock(parts)  # first: nothing below may remove another live run's files
     try:
+        for orphan in out.parent.glob(f".{out.name}.*.tmp"):  # left by a killed write
+            orphan.unlink(missing_ok=True)
         if existed and force:
             log(f"--force: discarding {parts}")
             _clear(parts, lock)
