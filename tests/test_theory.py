@@ -338,6 +338,8 @@ def test_spectral_tau_limit_exact_for_every_damping(scheme, xi):
         assert got == pytest.approx(2 * math.sqrt(2) / omega, rel=1e-9)
     if scheme in ("rk3", "heun3") and xi == 0.0:  # both have R(z) = 1 + z + z²/2 + z³/6
         assert got == pytest.approx(math.sqrt(3) / omega, rel=1e-9)
-    if xi == 1.0:  # R(τÃ) for Euler at τω = 0.1: a Jordan block of eigenvalue 0.9
-        rho = theory.discrete(A, "euler", 0.1 / omega, limits=False).spectral_radius
-        assert rho == pytest.approx(0.9, rel=1e-14)
+    if xi == 1.0:  # R(τÃ) for Euler at τω = 0.9 and ω = 12.62: a Jordan block of 0.1
+        # (from the matrix R's own eigenvalues it reads 0.1000000098)
+        A_j = baumgarte_At(12.62, 1.0)
+        rho = theory.discrete(A_j, "euler", 0.9 / 12.62, limits=False).spectral_radius
+        assert rho == pytest.approx(0.1, rel=1e-14)

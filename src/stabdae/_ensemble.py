@@ -215,10 +215,11 @@ def ensemble(
     law = check.law(law, who)
     adaptive = rtol is not None
     if adaptive:
-        if scheme is not None and check.scheme(scheme, who).name != "dopri5":
+        given = None if scheme is None else check.scheme(scheme, who).name
+        if given not in (None, "dopri5"):
             raise ValueError(
                 f"{who}: adaptive steps (rtol given) use the Dormand–Prince 5(4) pair; scheme "
-                f"must be 'dopri5' or left out, got {check.scheme(scheme, who).name!r}"
+                f"must be 'dopri5' or left out, got {given!r}"
             )
         scheme = dopri5()
         rtol = check.positive(rtol, "rtol", who)
@@ -231,9 +232,9 @@ def ensemble(
     tau = check.positive(tau, "tau", who)
     span = check.span(t0, t_end, who)
     if adaptive:
-        save_dt = span / DEFAULT_SAMPLES if save_dt is None else save_dt
+        save_dt = (span / DEFAULT_SAMPLES if save_dt is None
+                   else check.positive(save_dt, "save_dt", who))  # fmt: skip
         save_times = check.sample_times(t0, float(t_end), save_dt, who)
-        save_dt = check.positive(save_dt, "save_dt", who)
     else:
         nsteps, save_every = check.fixed_time_grid(span, tau, save_dt, who,
                                                    default_samples=DEFAULT_SAMPLES)  # fmt: skip

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import importlib.util
 import sys
@@ -45,8 +46,6 @@ def model_file(source) -> Path:
 def local_imports(path: Path) -> list[Path]:
     """The model file and the modules of its own folder that it imports, recursively (what
     its numbers can depend on besides the library)."""
-    import ast
-
     seen: list[Path] = []
     todo = [Path(path).resolve()]
     while todo:

@@ -225,28 +225,28 @@ def _common(units) -> str | None:
     return units.pop() if len(units) == 1 else None
 
 
+#: markers of variables whose entries each have their own unit -> the model property (and
+#: the dataset coordinate of the same name) that lists them
+_PER_ENTRY = {STATE: "state_units", COMPONENT: "component_units", RESIDUAL: "component_units",
+              MULTIPLIER: "multiplier_units", ACCELERATION: "acceleration_units"}  # fmt: skip
+
+
 def _resolve_units(marker: str, model) -> dict:
     """The units attributes of a variable: ``{"units": ...}``, or for a mixed variable
     ``{"units_per_component": <coordinate>}``."""
-    if marker == STATE:
-        common = _common(model.state_units) if model is not None else None
-        return {"units": common} if common else {"units_per_component": "state_units"}
-    if marker in (COMPONENT, RESIDUAL):
-        common = _common(model.component_units) if model is not None else None
-        if common:
-            return {"units": common}
-        extra = {"units_per_component": "component_units"}
-        if marker == RESIDUAL:
-            extra["comment_units"] = ("max over residual components of different units: in "
-                                      "the unit of the largest component")  # fmt: skip
-        return extra
     if marker == ENERGY:
         return {"units": getattr(model, "energy_units", "1")}
-    if marker in (MULTIPLIER, ACCELERATION):
-        coord = "multiplier_units" if marker == MULTIPLIER else "acceleration_units"
-        common = _common(getattr(model, coord)) if model is not None else None
-        return {"units": common} if common else {"units_per_component": coord}
-    return {"units": marker}
+    coord = _PER_ENTRY.get(marker)
+    if coord is None:
+        return {"units": marker}
+    common = _common(getattr(model, coord)) if model is not None else None
+    if common:
+        return {"units": common}
+    out = {"units_per_component": coord}
+    if marker == RESIDUAL:
+        out["comment_units"] = ("max over residual components of different units: in the "
+                                "unit of the largest component")  # fmt: skip
+    return out
 
 
 def variable(dims, data, long_name: str, units: str | None, **attrs) -> xr.Variable:
