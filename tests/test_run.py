@@ -78,7 +78,7 @@ def test_run_writes_dataset_and_pictures_and_refuses_to_overwrite(tmp_path, caps
     assert "summary" in printed and f"dataset written to {out}" in printed
     ds = xr.open_dataset(out)
     assert ds.fraction_bounded.dims == ("tau", "omega")
-    assert ds.residual_norm.dims == ("tau", "omega", "member", "time")
+    assert ds.residual_norm.dims == ("tau", "omega", "trace", "time")
     assert_schema(ds)
     assert "stabdae run study.toml: 12 grid points of 64 members" in ds.attrs["history"]
     assert ds.attrs["study"] == "study.toml" and ds.attrs["swept"] == "run.tau, law.omega"

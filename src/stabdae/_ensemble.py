@@ -18,16 +18,16 @@ from collections import Counter
 import numpy as np
 import xarray as xr
 
+from . import _measures, theory
 from . import _validate as check
-from . import theory
 from ._integrate import IntegrationWarning
 from ._laws import Theorem5
 from ._model import Model
 from ._schema import model_coords, provenance, schema_variable, variable
 from ._schemes import dopri5, dopri5_embedded_weights
 from ._status import Status
+from .kernels import decay
 from .kernels.adaptive import adaptive_ensemble_for
-from .kernels.decay import Summary
 from .kernels.ensemble import BLOCK, ensemble_kernel_for
 from .kernels.sampler import (
     CHUNK,
@@ -36,14 +36,19 @@ from .kernels.sampler import (
     residual_rows_for,
     sampler_for,
 )
+from .kernels.steps import integrator_for
 from .kernels.threads import default_threads, run_chunks
 
 __all__ = ["ensemble", "sample_perturbations"]
 
-#: a member "decayed" when it ended below max(‖α⁰‖, this × the ensemble's median floor)
-DECAYED_FLOOR_FACTOR = 10.0
 #: samples stored by default over a fixed-step run (the largest spacing that divides it)
 DEFAULT_SAMPLES = 200
+#: members whose residual traces are stored by default (enough for the pictures)
+DEFAULT_TRACES = 64
+#: steps of the linear prediction e^{Ãh} of an adaptive ensemble over its run
+PREDICTION_STEPS = 4096
+#: the largest reference residual history kept (steps × components; 128 MB)
+REFERENCE_MAX_ENTRIES = 16_000_000
 
 #: why members stopped, as the summary warning names it
 _STOPPED = {
@@ -147,6 +152,7 @@ def ensemble(
     threads: int | None = None,
     progress=None,
     residual_dtype="float32",
+    traces=DEFAULT_TRACES,
 ) -> xr.Dataset:
     """Integrate an ensemble of initial constraint perturbations in parallel.
 
@@ -177,12 +183,11 @@ def ensemble(
     params : mapping or array, optional
         Physical parameters.
     epsilon : float, optional
-        The ε of Definition 2: a member is *bounded* when ``max_t ‖g‖ ≤ ε`` and it decayed
-        (ended below ``max(‖α⁰‖, 10 × the ensemble's median floor)``).  Default
-        ``10 × radius high``.
+        The ε of Definition 2: a member is *bounded* when it is stable (see
+        ``stability_class``) and ``max_t ‖g‖ ≤ ε``.  Default ``10 × radius high``.
     divergence : float, optional
         Residual norm above which a member is frozen and flagged ``diverged``
-        (default ``1e3 × epsilon``).
+        (default ``1e3 × epsilon``, and at least 1: a residual of the model's own size).
     block : int
         Members integrated in lockstep per parallel work item (compile-time: a new value
         compiles a new kernel).  Does not change any number.
@@ -192,17 +197,26 @@ def ensemble(
     progress : callable ``(members_done, members)``, optional
         Called after each chunk of members has been integrated.
     residual_dtype : "float32" or "float64"
-        Storage of ``residual_norm``: float32 (default) halves the memory of large
-        ensembles (10⁶ members × 200 samples: 0.8 GB); float64 keeps every digit.
+        Storage of ``residual_norm``: float32 (default) halves its memory; float64 keeps
+        every digit.
+    traces : int, "all" or "none"
+        The members whose residual norms are stored (``residual_norm(trace, time)``, the
+        coordinate ``trace`` naming each stored member): this many, evenly spaced over the
+        members (default 64), all of them, or none.  No measurement depends on it: the
+        decay rate, floor and class of every member are measured at every step inside
+        the kernels.
 
     Returns
     -------
     xarray.Dataset
-        See ``docs/api.md``: ``residual_norm(member, time)`` (float32), ``alpha0``, ``x0``,
-        ``x_final``, ``beta``, ``gamma``, ``residual_floor``, ``bounded``, ``diverged`` and
-        ``diverged_step``, ``energy_drift``, ``status`` per member; ``fraction_bounded``,
-        ``stability_radius``, ``beta_median`` and, for constant laws, ``beta_theory``,
-        ``beta_theory_discrete``, ``spectral_radius``.
+        See ``docs/schema.md``: per member ``alpha0``, ``x0``, ``x_final``, ``beta`` with
+        ``beta_reason``, ``gamma``, ``residual_floor``, ``stability_class``, ``stable``,
+        ``bounded``, ``diverged``, ``status``, ``energy_drift`` and, for constant laws,
+        ``beta_predicted`` and ``beta_ratio``; ``residual_norm(trace, time)`` for the
+        traced members; the summaries ``fraction_stable``, ``fraction_bounded`` (with
+        Wilson 95 % intervals), ``beta_median`` (with an order-statistics interval),
+        ``stability_radius`` with its bracket, the counts behind them and, for constant
+        laws, the theory's ``beta_theory``, ``beta_theory_discrete``, ``spectral_radius``.
 
     Warns
     -----
@@ -243,7 +257,7 @@ def ensemble(
     low, high = check.radius(radius, who)
     seed = check.seed(seed, who)
     epsilon = 10.0 * high if epsilon is None else check.positive(epsilon, "epsilon", who)
-    divergence = (1e3 * epsilon if divergence is None
+    divergence = (max(1e3 * epsilon, 1.0) if divergence is None
                   else check.positive(divergence, "divergence", who))  # fmt: skip
     threads = _threads(threads, who)
     if progress is not None and not callable(progress):
@@ -253,13 +267,20 @@ def ensemble(
         members = check.count(members, "members", who)
     else:
         x0 = check.initial_states(model, x0, who)
+        members = x0.shape[0]
+    trace_row, traced = _trace_rows(traces, members, who)
     bound = check.bound_law(law, model, who)
+    R, h_pred = _prediction(law, model, scheme, None if adaptive else tau,
+                            float(t_end) - t0)  # fmt: skip
 
     clock = time.perf_counter()
+    g_ref = np.zeros((0, model.n_residual))
     if x0 is None:
         targets = draw_alphas(model.n_residual, members, (low, high),
                               np.random.default_rng(seed))  # fmt: skip
         x0, alpha0, status = _place(model, targets, p, t0, threads)
+        if not adaptive:
+            g_ref = _reference_residuals(model, bound, scheme, p, t0, tau, nsteps)
     else:
         alpha0 = _residual_rows(model, x0, p, t0, threads)
         status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
@@ -269,24 +290,26 @@ def ensemble(
     M = x0.shape[0]
     clock = time.perf_counter()
     if adaptive:
-        out = _run_adaptive(model, bound, x0, status, p, t0, save_times, rtol, atol, tau,
-                            divergence, rdtype, threads, progress)  # fmt: skip
+        out = _run_adaptive(model, bound, x0, alpha0, status, p, t0, save_times, rtol, atol,
+                            tau, divergence, R, h_pred, trace_row, traced, rdtype, threads,
+                            progress)  # fmt: skip
         run = dict(method="dopri5-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
                    t_end=float(t_end), save_dt=save_dt)  # fmt: skip
     else:
-        out = _run_fixed(model, bound, scheme, x0, p, t0, tau, nsteps, save_every, block,
-                         divergence, rdtype, threads, progress)  # fmt: skip
+        out = _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every,
+                         block, divergence, g_ref, R, trace_row, traced, rdtype, threads,
+                         progress)  # fmt: skip
         run = dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every,
                    steps=nsteps)  # fmt: skip
     wall_integrate = time.perf_counter() - clock
     status = np.where(status != 0, status, out["status"]).astype(np.int8)
     clock = time.perf_counter()
     ds = _ensemble_dataset(
-        model, p, law, scheme, bound, out["times"], x0, alpha0, out["norms"], out["x_final"],
-        status, out["fail_step"], out["e0"], out["e1"], epsilon, out["summary"],
-        dict(**run, members=M, seed=seed, radius_low=low, radius_high=high, epsilon=epsilon,
-             divergence=divergence, sampling_rtol=SAMPLING_RTOL,
-             threads=threads if threads is not None else default_threads()),
+        model, p, law, scheme, bound, out["times"], x0, alpha0, out["norms"], traced,
+        out["x_final"], status, out["fail_step"], out["e0"], out["e1"], epsilon, out["meas"],
+        R, dict(**run, members=M, seed=seed, radius_low=low, radius_high=high,
+                epsilon=epsilon, divergence=divergence, sampling_rtol=SAMPLING_RTOL,
+                threads=threads if threads is not None else default_threads()),
         extra=out.get("extra"),
     )  # fmt: skip
     # wall times (compilation included on a first call) for benchmarks; not part of the data
@@ -296,31 +319,90 @@ def ensemble(
     return ds
 
 
-def _outputs(x0, nsave, rdtype):
+def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps):
+    """The residual ``g`` at every step of the trajectory from the model's reference state
+    (``α⁰ = 0``): the truncation error's forced response, the same for every member of a
+    sampled ensemble up to ``O(‖α⁰‖)``.  Each member's decay is measured on its distance
+    from it, so that the rate is read far below the floor the raw residual settles on.
+    None (an empty array: the raw residual is measured) when it would take more than
+    ``REFERENCE_MAX_ENTRIES`` numbers or does not run to the end."""
+    ng = model.n_residual
+    if (nsteps + 1) * ng > REFERENCE_MAX_ENTRIES:
+        return np.zeros((0, ng))
+    kernel = integrator_for(model, bound, "ldl")
+    out_x = np.empty((nsteps + 1, 2 * model.n))
+    out_g = np.full((nsteps + 1, ng), np.nan)
+    out_e = np.empty(nsteps + 1)
+    status, _ = kernel(model.reference_state(p), t0, tau, nsteps, 1, p, bound.matrix,
+                       bound.scalars, scheme.A, scheme.b, scheme.c, 0, 0.0, out_x, out_g,
+                       out_e)  # fmt: skip
+    if status != 0 or not np.isfinite(out_g).all():
+        return np.zeros((0, ng))
+    return out_g
+
+
+def _trace_rows(traces, members: int, who: str):
+    """``(trace_row, traced)``: each member's row of the stored traces (−1: none) and the
+    traced members, evenly spaced over the ensemble."""
+    if isinstance(traces, str):
+        if traces not in ("all", "none"):
+            raise ValueError(f"{who}: traces must be a number of members, 'all' or 'none', "
+                             f"got {traces!r}")  # fmt: skip
+        count = members if traces == "all" else 0
+    elif isinstance(traces, (bool, np.bool_)) or not isinstance(traces, (int, np.integer)):
+        raise TypeError(f"{who}: traces must be a number of members, 'all' or 'none', got "
+                        f"{type(traces).__name__}")  # fmt: skip
+    elif traces < 0:
+        raise ValueError(f"{who}: traces must be >= 0, got {traces}")
+    else:
+        count = min(int(traces), members)
+    traced = np.unique(np.linspace(0, members - 1, count).round().astype(np.int64)) if count \
+        else np.zeros(0, dtype=np.int64)  # fmt: skip
+    trace_row = np.full(members, -1, dtype=np.int64)
+    trace_row[traced] = np.arange(traced.size)
+    return trace_row, traced
+
+
+def _prediction(law, model, scheme, tau, span):
+    """The one-step propagator of each member's linear prediction and its step: ``R(τÃ)``
+    for fixed steps, ``e^{Ãh}`` over ``PREDICTION_STEPS`` steps for adaptive ones; an
+    empty matrix for laws that are not constant."""
+    if not law.is_constant:
+        return np.zeros((0, 0)), 1.0
+    A = np.asarray(law.A_tilde(model), dtype=float)
+    if tau is None:
+        from scipy.linalg import expm
+
+        h = span / PREDICTION_STEPS
+        return np.ascontiguousarray(expm(A * h)), h
+    return np.ascontiguousarray(theory.step_matrix(A, scheme, tau)), tau
+
+
+def _outputs(x0, ntraced, nsave, rdtype):
     """The per-member outputs, allocated empty: the kernels write every element (the
     fixed-step kernel on its own threads, so that the pages are first touched there)."""
     M = x0.shape[0]
-    return {"norms": np.empty((M, nsave), dtype=rdtype), "x_final": np.empty_like(x0),
+    return {"norms": np.empty((ntraced, nsave), dtype=rdtype), "x_final": np.empty_like(x0),
             "status": np.empty(M, dtype=np.int8), "fail_step": np.empty(M, dtype=np.int64),
-            "e0": np.empty(M), "e1": np.empty(M), "summary": Summary(M)}  # fmt: skip
+            "e0": np.empty(M), "e1": np.empty(M),
+            "meas": np.empty((M, decay.NCOLS))}  # fmt: skip
 
 
-def _run_fixed(model, bound, scheme, x0, p, t0, tau, nsteps, save_every, block, divergence,
-               rdtype, threads, progress) -> dict:  # fmt: skip
-    """The block-lockstep kernel over chunks of blocks on threads; each chunk's traces
-    summarized and fitted by the thread that integrated them, while they are in its
-    cache."""
+def _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every, block,
+               divergence, g_ref, R, trace_row, traced, rdtype, threads,
+               progress) -> dict:  # fmt: skip
+    """The block-lockstep kernel over chunks of blocks on threads."""
     M = x0.shape[0]
-    out = _outputs(x0, nsteps // save_every + 1, rdtype)
-    out["times"] = times = t0 + tau * save_every * np.arange(nsteps // save_every + 1)
+    out = _outputs(x0, traced.size, nsteps // save_every + 1, rdtype)
+    out["times"] = t0 + tau * save_every * np.arange(nsteps // save_every + 1)
     kernel = ensemble_kernel_for(model, bound, scheme, block)
-    norms, summary = out["norms"], out["summary"]
+    alpha0 = np.ascontiguousarray(alpha0)
 
     def chunk(lo, hi):
-        kernel(x0, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars, scheme.A,
-               scheme.b, scheme.c, divergence, norms, out["x_final"], out["status"],
-               out["fail_step"], out["e0"], out["e1"], lo, hi)  # fmt: skip
-        summary.rows(norms, times, min(lo * block, M), min(hi * block, M))
+        kernel(x0, alpha0, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
+               scheme.A, scheme.b, scheme.c, divergence, g_ref, R, trace_row, out["norms"],
+               out["meas"], out["x_final"], out["status"], out["fail_step"], out["e0"],
+               out["e1"], lo, hi)  # fmt: skip
 
     run_chunks(
         chunk, -(-M // block), threads=threads,
@@ -330,13 +412,13 @@ def _run_fixed(model, bound, scheme, x0, p, t0, tau, nsteps, save_every, block, 
     return out
 
 
-def _run_adaptive(model, bound, x0, status, p, t0, save_times, rtol, atol, first_step,
-                  divergence, rdtype, threads, progress) -> dict:  # fmt: skip
+def _run_adaptive(model, bound, x0, alpha0, status, p, t0, save_times, rtol, atol,
+                  first_step, divergence, R, h_pred, trace_row, traced, rdtype, threads,
+                  progress) -> dict:  # fmt: skip
     """The per-member adaptive kernel over chunks of members on threads."""
     M = x0.shape[0]
-    out = _outputs(x0, save_times.shape[0] + 1, rdtype)
-    out["times"] = times = np.concatenate([[t0], save_times])
-    out["norms"].fill(np.nan)
+    out = _outputs(x0, traced.size, save_times.shape[0] + 1, rdtype)
+    out["times"] = np.concatenate([[t0], save_times])
     out["fail_step"].fill(-1)
     out["e0"].fill(np.nan)
     out["e1"].fill(np.nan)
@@ -345,14 +427,14 @@ def _run_adaptive(model, bound, x0, status, p, t0, save_times, rtol, atol, first
     nfev = np.zeros(M, dtype=np.int64)
     kernel = adaptive_ensemble_for(model, bound)
     scheme = dopri5()
-    norms, summary = out["norms"], out["summary"]
+    alpha0 = np.ascontiguousarray(alpha0)
 
     def chunk(lo, hi):
-        kernel(x0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
+        kernel(x0, alpha0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
                dopri5_embedded_weights(), scheme.c, rtol, atol, first_step, 10_000_000,
-               divergence, norms, out["x_final"], out["status"], out["fail_step"], out["e0"],
-               out["e1"], steps, nfev, lo, hi)  # fmt: skip
-        summary.rows(norms, times, lo, hi)
+               divergence, R, h_pred, trace_row, out["norms"], out["meas"], out["x_final"],
+               out["status"], out["fail_step"], out["e0"], out["e1"], steps, nfev, lo,
+               hi)  # fmt: skip
 
     run_chunks(chunk, M, threads=threads, progress=progress)
     out["extra"] = {"steps_accepted": steps, "rhs_evaluations": nfev}
@@ -375,21 +457,26 @@ def _warn_stopped(model, status) -> None:
     )
 
 
-def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_final,
-                      status, fail_step, e0, e1, epsilon, summary, run, extra=None):  # fmt: skip
-    ok = status == 0
-    max_res, final = summary.largest, summary.last
-    beta, gamma, floor = summary.beta, summary.gamma, summary.floor
+def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
+                      x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
+                      extra=None):  # fmt: skip
+    C = decay
+    meas[status != 0, C.C_BETA_PRED] = np.nan  # (not placed: measured on nothing)
+    for c in (C.C_BETA, C.C_GAMMA):
+        meas[status != 0, c] = np.nan
+    meas[(status != 0) & (meas[:, C.C_REASON] == C.R_FITTED), C.C_REASON] = C.R_STOPPED
+    cls = _measures.classify(meas, status, epsilon)
     alpha_norm = np.max(np.abs(alpha0), axis=1)
-    floor_ref = float(np.nanmedian(np.where(ok, floor, np.nan))) if ok.any() else np.nan
-    decayed = ok & (final <= np.maximum(alpha_norm, DECAYED_FLOOR_FACTOR * floor_ref))
-    bounded = ok & (max_res <= epsilon) & decayed
-    diverged = status == int(Status.DIVERGED)
-    diverged |= status == int(Status.NONFINITE_STATE)
-    diverged |= status == int(Status.SINGULAR_S)
+    summary, radius_why = _measures.summaries(meas, cls, status, alpha_norm, epsilon)
+    stable = np.isin(cls, _measures.STABLE)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bounded = stable & (meas[:, C.C_LARGEST] <= epsilon)
+        overshoot = meas[:, C.C_LARGEST] / meas[:, C.C_INITIAL]
+    diverged = cls == _measures.DIVERGED
 
     coords = {
         "member": variable("member", np.arange(x0.shape[0]), "ensemble member", "1"),
+        "trace": variable("trace", traced, "member whose residual norm is stored", "1"),
         **model_coords(model, times),
     }
     values = {
@@ -398,40 +485,50 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, x_
         "alpha0_norm": alpha_norm,
         "x0": x0,
         "x_final": x_final,
-        "beta": beta,
-        "gamma": gamma,
-        "residual_floor": floor,
-        "max_residual": max_res,
+        "beta": meas[:, C.C_BETA],
+        "beta_reason": meas[:, C.C_REASON].astype(np.int8),
+        "gamma": meas[:, C.C_GAMMA],
+        "residual_floor": meas[:, C.C_FLOOR],
+        "floor_reached": np.nan_to_num(meas[:, C.C_FLOOR_REACHED]).astype(np.int8),
+        "max_residual": meas[:, C.C_LARGEST],
+        "final_residual": meas[:, C.C_FINAL],
+        "overshoot": overshoot,
+        "fit_start": times[0] + meas[:, C.C_FIT_START],
+        "fit_end": times[0] + meas[:, C.C_FIT_END],
+        "fit_points": meas[:, C.C_POINTS].astype(np.int64),
+        "fit_kind": meas[:, C.C_KIND].astype(np.int8),
+        "stability_class": cls,
+        "stable": stable.astype(np.int8),
         "bounded": bounded.astype(np.int8),
         "diverged": diverged.astype(np.int8),
         "diverged_step": fail_step,
         "status": status,
-        "fraction_bounded": float(bounded.mean()),
-        "stability_radius": _stability_radius(alpha_norm, bounded),
-        "beta_median": float(np.nanmedian(beta)) if np.isfinite(beta).any() else np.nan,
+        **summary,
     }
+    if R.shape[0] > 0:
+        beta_pred = meas[:, C.C_BETA_PRED]
+        values["beta_predicted"] = beta_pred
+        with np.errstate(invalid="ignore", divide="ignore"):
+            values["beta_ratio"] = meas[:, C.C_BETA] / beta_pred
+        med = _measures.median_interval(values["beta_ratio"])
+        values["beta_ratio_median"] = med[0]
+        values["overshoot_theory"] = theory.transient_peak(R)
     if model.energy is not None:
         values["energy_drift"] = e1 - e0
     values.update(extra or {})
     values.update(_theory_values(law, model, p, scheme, run.get("tau"), x0, x_final, times,
-                                 norms, alpha0, floor))  # fmt: skip
+                                 norms, traced, alpha0, meas[:, C.C_FLOOR]))  # fmt: skip
     data = {name: schema_variable(name, val, model) for name, val in values.items()}
     data["residual_norm"].attrs["comment"] = (
         f"stored as {norms.dtype}; " + data["residual_norm"].attrs["comment"]
     )
+    data["stability_radius"].attrs["comment"] = radius_why
     attrs = provenance(model, p, law, scheme, f"ensemble of {x0.shape[0]} members", **run)
     attrs["residual_norm_dtype"] = str(norms.dtype)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _stability_radius(alpha_norm, bounded) -> float:
-    """Largest δ with every sampled ‖α⁰‖ ≤ δ bounded: just below the smallest failure."""
-    if bounded.all():
-        return float(alpha_norm.max())
-    return float(alpha_norm[~bounded].min())
-
-
-def _theory_values(law, model, p, scheme, tau, x0, x_final, times, norms, alpha0,
+def _theory_values(law, model, p, scheme, tau, x0, x_final, times, norms, traced, alpha0,
                    floor) -> dict:  # fmt: skip
     """The theorems' predictions stored beside the measurements (:mod:`stabdae.theory`)."""
     if law.is_constant and tau is None:  # adaptive steps: only the continuous rate
@@ -447,9 +544,9 @@ def _theory_values(law, model, p, scheme, tau, x0, x_final, times, norms, alpha0
            "beta_theorem5_printed": c["beta_printed"]}  # fmt: skip
     # the Lyapunov argument bounds the 2-norm: γ = √(l_m/l₁)‖α⁰‖₂ also bounds ‖α(t)‖∞
     alpha2 = np.linalg.norm(alpha0, axis=1)
-    for which in ("proven", "printed"):
+    for which in ("proven", "printed"):  # judged on the stored traces
         out[f"bound_{which}_held"] = theory.bound_held(
-            times, norms, alpha2, c[f"beta_{which}"], c["gamma_factor"], floor
+            times, norms, alpha2[traced], c[f"beta_{which}"], c["gamma_factor"], floor[traced]
         ).astype(np.int8)
     out["gamma_theorem5"] = c["gamma_factor"] * alpha2
     return out

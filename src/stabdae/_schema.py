@@ -27,8 +27,10 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ._measures import CLASSES
 from ._status import Status, status_flag_attrs
 from ._version import __version__
+from .kernels.decay import KINDS, REASONS
 from .kernels.fma import HOST_FMA
 
 __all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "provenance",
@@ -41,6 +43,13 @@ STATE, COMPONENT, RESIDUAL, ENERGY = "@state", "@component", "@residual", "@ener
 MULTIPLIER, ACCELERATION = "@multiplier", "@acceleration"
 
 _FLAG = {"flag_values": [0, 1], "flag_meanings": "no yes"}
+
+
+def _flags(names: dict) -> dict:
+    """CF flag attributes of an int8 code variable, from ``{code: meaning}``."""
+    words = [re.sub(r"[^0-9a-zA-Z]+", "_", v.split(":")[0].split(" (")[0]).strip("_")
+             for v in names.values()]  # fmt: skip
+    return {"flag_values": list(names), "flag_meanings": " ".join(words)}
 _HELD = {**_FLAG, "comment": "judged above 10x the member's residual floor, that floor added "
          "to the bound"}  # fmt: skip
 
@@ -56,19 +65,39 @@ SCHEMA: dict[str, tuple] = {
                    "M dv/dt = F^T lambda - gamma", MULTIPLIER, {}),
     "acceleration": (("time", "coordinate"), "acceleration dv/dt", ACCELERATION, {}),
     # --- an ensemble (and, per grid point, a study)
-    "residual_norm": (("member", "time"), "max-norm of the constraint residual", RESIDUAL,
-                      {"comment": "NaN after a member stopped"}),
+    "residual_norm": (("trace", "time"), "max-norm of the constraint residual of the "
+                      "traced members", RESIDUAL, {"comment": "NaN after a member stopped"}),
     "alpha0": (("member", "component"), "initial perturbation g(x0, t0) achieved", COMPONENT,
                {}),
     "alpha0_norm": ("member", "max-norm of alpha0", RESIDUAL, {}),
     "x0": (("member", "state"), "initial state", STATE, {}),
     "x_final": (("member", "state"), "final state (last state before a stop)", STATE, {}),
-    "beta": ("member", "fitted decay rate of the residual norm", "s-1",
-             {"comment": "fit on the transient above the floor (stabdae.kernels.decay)"}),
+    "beta": ("member", "decay rate of the residual norm, measured at every step", "s-1",
+             {"comment": "fitted on the right envelope of the transient above the floor; "
+              "NaN with beta_reason where there is none"}),
+    "beta_reason": ("member", "why beta is or is not fitted", "1", _flags(REASONS)),
     "gamma": ("member", "prefactor: max over the transient of |g| exp(beta t)", RESIDUAL, {}),
-    "residual_floor": ("member", "residual level at the end (truncation floor)", RESIDUAL, {}),
-    "max_residual": ("member", "largest residual norm reached", RESIDUAL, {}),
-    "bounded": ("member", "stayed within epsilon and decayed (Definition 2)", "1", _FLAG),
+    "residual_floor": ("member", "largest residual norm over the last fifth of the run "
+                       "(truncation floor)", RESIDUAL, {}),
+    "floor_reached": ("member", "the residual settled before the end (not still decaying)",
+                      "1", _FLAG),
+    "max_residual": ("member", "largest residual norm reached (at any step)", RESIDUAL, {}),
+    "final_residual": ("member", "residual norm at the last state", RESIDUAL, {}),
+    "overshoot": ("member", "max_residual / alpha0_norm", "1", {}),
+    "overshoot_theory": ((), "sup_k of the max-norm of R(tau A~)^k: the law's own transient "
+                         "growth", "1", {}),
+    "fit_start": ("member", "start of the window beta is fitted on", "s", {}),
+    "fit_end": ("member", "end of the window beta is fitted on", "s", {}),
+    "fit_points": ("member", "right-envelope points in the fit window", "1", {}),
+    "fit_kind": ("member", "kind of decay fit", "1", _flags(KINDS)),
+    "beta_predicted": ("member", "beta of the member's linear prediction R^k alpha0 (or "
+                       "exp(A~ t) alpha0), same window and fit", "s-1", {}),
+    "beta_ratio": ("member", "beta / beta_predicted", "1", {}),
+    "beta_ratio_median": ((), "median of beta / beta_predicted", "1", {}),
+    "stability_class": ("member", "stability class", "1", _flags(dict(enumerate(CLASSES)))),
+    "stable": ("member", "decayed, overshot by the law's transient, or sat at the floor "
+               "(not growing, not diverged)", "1", _FLAG),
+    "bounded": ("member", "stable and within epsilon (Definition 2)", "1", _FLAG),
     "diverged": ("member", "stopped: blew up (diverged, non-finite or singular S)", "1",
                  _FLAG),
     "diverged_step": ("member", "step at which the member stopped (-1: ran to the end)", "1",
@@ -77,10 +106,27 @@ SCHEMA: dict[str, tuple] = {
     "steps_accepted": ("member", "accepted steps (adaptive steps)", "1", {}),
     "rhs_evaluations": ("member", "right-hand-side evaluations (adaptive steps)", "1", {}),
     "energy_drift": ("member", "energy change E(final) - E(x0)", ENERGY, {}),
-    "fraction_bounded": ((), "fraction of bounded members", "1", {}),
-    "stability_radius": ((), "largest |alpha0| below which every member is bounded", RESIDUAL,
-                         {}),
-    "beta_median": ((), "median fitted decay rate", "s-1", {}),
+    "fraction_stable": ((), "fraction of stable members (of those that ran)", "1", {}),
+    "fraction_stable_low": ((), "Wilson 95% interval of fraction_stable, low", "1", {}),
+    "fraction_stable_high": ((), "Wilson 95% interval of fraction_stable, high", "1", {}),
+    "fraction_bounded": ((), "fraction of bounded members (of those that ran)", "1", {}),
+    "fraction_bounded_low": ((), "Wilson 95% interval of fraction_bounded, low", "1", {}),
+    "fraction_bounded_high": ((), "Wilson 95% interval of fraction_bounded, high", "1", {}),
+    "stability_radius": ((), "delta*: between the largest |alpha0| with every member up to it "
+                         "stable and the smallest that is not", RESIDUAL, {}),
+    "stability_radius_low": ((), "delta* bracket, low: every member up to it stable",
+                             RESIDUAL, {}),
+    "stability_radius_high": ((), "delta* bracket, high: smallest |alpha0| not stable",
+                              RESIDUAL, {}),
+    "beta_median": ((), "median measured decay rate", "s-1", {}),
+    "beta_median_low": ((), "95% order-statistics interval of beta_median, low", "s-1", {}),
+    "beta_median_high": ((), "95% order-statistics interval of beta_median, high", "s-1", {}),
+    "members_run": ((), "members that ran (placed, not out of steps)", "1", {}),
+    "members_stable": ((), "stable members", "1", {}),
+    "members_bounded": ((), "bounded members", "1", {}),
+    "members_diverged": ((), "diverged members", "1", {}),
+    "members_growing": ((), "growing members", "1", {}),
+    "members_with_beta": ((), "members with a measured beta", "1", {}),
     # --- the theorems' predictions (ensemble, study grid)
     "beta_theory": ((), "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1", {}),
     "beta_theory_discrete": ((), "discrete decay rate -ln rho(R(tau A~))/tau", "s-1", {}),
@@ -136,10 +182,17 @@ _GROUPS = (
      "`with_multipliers=True`)", ("x", "residual", "residual_norm", "energy", "multiplier",
                                   "acceleration")),
     ("An ensemble: `ensemble` (and per grid point, `stabdae run`)", (
-        "residual_norm", "alpha0", "alpha0_norm", "x0", "x_final", "beta", "gamma",
-        "residual_floor", "max_residual", "bounded", "diverged", "diverged_step", "status",
-        "steps_accepted", "rhs_evaluations", "energy_drift", "fraction_bounded",
-        "stability_radius", "beta_median", "beta_theory", "beta_theory_discrete",
+        "residual_norm", "alpha0", "alpha0_norm", "x0", "x_final", "beta", "beta_reason",
+        "gamma", "residual_floor", "floor_reached", "max_residual", "final_residual",
+        "overshoot", "fit_start", "fit_end", "fit_points", "fit_kind", "beta_predicted",
+        "beta_ratio", "stability_class", "stable", "bounded", "diverged", "diverged_step",
+        "status", "steps_accepted", "rhs_evaluations", "energy_drift", "fraction_stable",
+        "fraction_stable_low", "fraction_stable_high", "fraction_bounded",
+        "fraction_bounded_low", "fraction_bounded_high", "stability_radius",
+        "stability_radius_low", "stability_radius_high", "beta_median", "beta_median_low",
+        "beta_median_high", "beta_ratio_median", "members_run", "members_stable",
+        "members_bounded", "members_diverged", "members_growing", "members_with_beta",
+        "overshoot_theory", "beta_theory", "beta_theory_discrete",
         "spectral_radius", "norm_max", "norm_weighted", "norm_condition", "lambda_min_W",
         "beta_theorem5_proven", "beta_theorem5_printed", "gamma_theorem5",
         "bound_proven_held", "bound_printed_held")),

@@ -1,6 +1,6 @@
 """Pictures of a study dataset (``stabdae plot OUT.nc``; written by ``stabdae run``).
 
-* ``<stem>_stability.png`` — the stability map: ``fraction_bounded`` over the first two
+* ``<stem>_stability.png`` — the stability map: ``fraction_stable`` over the first two
   swept axes, with the theory's boundaries drawn over it (``ρ(R(τÃ)) = 1`` and the
   weighted-norm condition of Theorems 6/7); with one swept axis, a curve.
 * ``<stem>_decay.png`` — residual decay of sampled members at one grid point, each with
@@ -95,16 +95,16 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
     dims = _sweep_dims(ds)
     fig, ax = plt.subplots(figsize=(7.2, 5.2), constrained_layout=True)
     title = f"{ds.attrs.get('model', '')}: {ds.attrs.get('law', '')} law, " \
-            f"{ds.attrs.get('scheme', '')} — fraction of members bounded"  # fmt: skip
+            f"{ds.attrs.get('scheme', '')} — fraction of members stable"  # fmt: skip
     if len(dims) >= 2:
         xd, yd = dims[0], dims[1]
         sub, note = _first_of_others(ds, (xd, yd))
         x, y = sub[xd].values, sub[yd].values
         xlog, ylog = _is_log(x), _is_log(y)
-        frac = sub["fraction_bounded"].transpose(yd, xd).values
+        frac = sub[_fraction(sub)].transpose(yd, xd).values
         mesh = ax.pcolormesh(_edges(x, xlog), _edges(y, ylog), frac, cmap="viridis",
                              vmin=0, vmax=1, shading="flat")  # fmt: skip
-        fig.colorbar(mesh, ax=ax, label="fraction of members bounded (Definition 2)")
+        fig.colorbar(mesh, ax=ax, label="fraction of members stable (not growing, not diverged)")
         handles = []
         xe, ye = _edges(x, xlog), _edges(y, ylog)
         for var, style, label in (
@@ -134,7 +134,8 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
     elif len(dims) == 1:
         xd = dims[0]
         x = ds[xd].values
-        ax.plot(x, ds["fraction_bounded"].values, "o-", label="fraction bounded (measured)")
+        ax.plot(x, ds[_fraction(ds)].values, "o-",
+                label=_fraction(ds).replace("_", " ") + " (measured)")
         if "spectral_radius" in ds:
             rho = ds["spectral_radius"].values
             ax.plot(x, np.minimum(rho, 2.0), "s--", color="gray", label="ρ(R(τÃ)) (theory)")
@@ -144,13 +145,19 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
         ax.set_ylim(-0.05, 2.05)
         ax.legend(fontsize=9)
     else:
-        frac = float(ds.fraction_bounded)
-        ax.text(0.5, 0.5, f"nothing swept: fraction bounded = {frac:.3g}", ha="center",
+        frac = float(ds[_fraction(ds)])
+        name = _fraction(ds).replace("_", " ")
+        ax.text(0.5, 0.5, f"nothing swept: {name} = {frac:.3g}", ha="center",
                 transform=ax.transAxes)  # fmt: skip
     ax.set_title(title, fontsize=10)
     fig.savefig(path, dpi=130)
     plt.close(fig)
     return path
+
+
+def _fraction(ds) -> str:
+    """The fraction the pictures show: stable members (bounded in older datasets)."""
+    return "fraction_stable" if "fraction_stable" in ds else "fraction_bounded"
 
 
 def _pick_point(ds):
@@ -159,11 +166,10 @@ def _pick_point(ds):
     dims = _sweep_dims(ds)
     if not dims:
         return {}
-    frac = ds["fraction_bounded"]
-    # samples of the transient above 10x the floor, median over the upper half of members
-    above = (ds["residual_norm"] > 10.0 * ds["residual_floor"]).sum("time")
-    big = ds["alpha0_norm"] >= ds["alpha0_norm"].median("member")
-    visible = above.where(big).median("member")
+    frac = ds["fraction_stable"] if "fraction_stable" in ds else ds["fraction_bounded"]
+    # samples of the transient above 10x the floor, median over the traced members
+    floor = ds["residual_floor"].sel(member=ds["trace"])
+    visible = (ds["residual_norm"] > 10.0 * floor).sum("time").median("trace")
     score = xr.where(frac >= 0.99, visible.fillna(-1.0), -np.inf)
     if not np.isfinite(score.values).any():
         score = frac
@@ -179,16 +185,19 @@ def decay_curves(ds: xr.Dataset, path: Path, members: int = 12) -> Path:
     fig, ax = plt.subplots(figsize=(7.2, 5.0), constrained_layout=True)
     # members spread over the upper half of the perturbation sizes: the ones whose decay
     # is visible above the truncation floor
-    order = np.argsort(-sub["alpha0_norm"].values)
+    traced = sub["trace"].values
+    order = np.argsort(-sub["alpha0_norm"].values[traced])
     top = order[: max(1, len(order) // 2)]
-    chosen = top[np.linspace(0, len(top) - 1, min(members, len(top))).astype(int)]
-    colors = plt.cm.viridis(np.linspace(0, 0.9, len(chosen)))
+    chosen = top[np.linspace(0, len(top) - 1, min(members, len(top))).astype(int)] \
+        if len(top) else np.zeros(0, dtype=int)  # fmt: skip
+    colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(chosen), 1)))
     for c, j in zip(colors, chosen):
         y = sub["residual_norm"].values[j].astype(float)
         ok = np.isfinite(y)
         ax.semilogy(t[ok], y[ok], "-", color=c, lw=1.1)
-        b, g = float(sub["beta"].values[j]), float(sub["gamma"].values[j])
-        if np.isfinite(b) and np.isfinite(g):
+        b = float(sub["beta"].values[traced[j]])
+        g = float(sub["gamma"].values[traced[j]])
+        if np.isfinite(b) and np.isfinite(g):  # only fits that exist
             ax.semilogy(t, g * np.exp(-b * t), ":", color=c, lw=0.9)
     if "beta_theory_discrete" in sub and np.isfinite(float(sub["beta_theory_discrete"])):
         bd = float(sub["beta_theory_discrete"])
@@ -202,7 +211,7 @@ def decay_curves(ds: xr.Dataset, path: Path, members: int = 12) -> Path:
             a0 = float(np.nanmax(sub["gamma_theorem5"].values))
             ax.semilogy(t, a0 * np.exp(-b * t), st, lw=1.4,
                         label=f"Theorem 5 bound, {name} β = {b:.4g} s⁻¹")  # fmt: skip
-    data = sub["residual_norm"].values[chosen].astype(float)
+    data = sub["residual_norm"].values[chosen].astype(float) if len(chosen) else np.zeros(0)
     data = data[np.isfinite(data) & (data > 0)]
     if data.size:
         ax.set_ylim(0.3 * data.min(), 3.0 * data.max())

@@ -153,6 +153,26 @@ def spectral_radius(R) -> float:
 _CLUSTER_RTOL = 1e-6
 
 
+def transient_peak(R, max_steps: int = 100_000) -> float:
+    """``sup_k ‖R^k‖∞``: how far the linear residual recursion ``g_{k+1} = R g_k`` can
+    carry a perturbation above its start (1 for a contraction in the max-norm; near
+    ``ω/e``-fold growth of ``‖e^{Ãt}‖`` for critically damped Baumgarte at small steps);
+    ``inf`` when the powers grow past ``1e12`` (``ρ(R) ≥ 1``).  The powers are taken until
+    they fall below a millionth of the peak (or ``max_steps``)."""
+    R = np.asarray(R, dtype=float)
+    P = np.eye(R.shape[0])
+    peak = 1.0
+    for _ in range(max_steps):
+        P = R @ P
+        nrm = float(np.abs(P).sum(axis=1).max())
+        if not nrm <= 1e12:
+            return math.inf
+        peak = max(peak, nrm)
+        if nrm < 1e-6 * peak:
+            break
+    return peak
+
+
 def eigenvalues(A_tilde) -> np.ndarray:
     """Eigenvalues of ``Ã`` with every cluster of a multiple eigenvalue replaced by its
     mean.  A defective eigenvalue (critically damped Baumgarte: a Jordan block) is computed

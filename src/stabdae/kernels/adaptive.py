@@ -18,6 +18,7 @@ from numba import njit
 
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
+from .decay import begin, finish, ladders, observe, predict, scratch
 from .rhs import kernels_for
 from .steps import sample_writer
 
@@ -40,9 +41,11 @@ def adaptive_ensemble_for(model, bound):
                 lambda: _build_adaptive_ensemble(kernels_for(model, bound)))
 
 
-def _adaptive_loop(K, save, label: str):
+def _adaptive_loop(K, save, label: str, accepted_step=None):
     """The Dormand–Prince loop of one trajectory, with ``save(j, t, x, p, ws, g, out)``
-    storing sample ``j`` (it returns True to stop the trajectory: status DIVERGED).
+    storing sample ``j`` (it returns True to stop the trajectory: status DIVERGED) and
+    ``accepted_step(t, ws, out)`` called after every accepted step, with ``ws.g`` the
+    residual at the new state (the last stage is evaluated there: first same as last).
 
     ``run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c, rtol, atol,
     h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g, out, counts)`` integrates ``x`` in
@@ -56,6 +59,8 @@ def _adaptive_loop(K, save, label: str):
     """
     rhs, project = K.rhs, K.project
     N2 = 2 * K.n
+    if accepted_step is None:
+        accepted_step = _no_hook
 
     @njit(error_model="numpy")
     def f_eval(t, x, p, law_mat, law_scal, ws, xdot):
@@ -173,6 +178,7 @@ def _adaptive_loop(K, save, label: str):
                     if st != 0:
                         counts[0], counts[1], counts[2] = accepted, rejected, nfev
                         return st, j + 1
+                accepted_step(t, ws, out)
                 fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e ** -0.2))
                 if after_reject:
                     fac = min(fac, 1.0)
@@ -192,6 +198,11 @@ def _adaptive_loop(K, save, label: str):
 
     tag(kernel_key(K.key, f"adaptive-loop-{label}"), f_eval, rms_error, run)
     return run
+
+
+@njit(forceinline=True)
+def _no_hook(t, ws, out):
+    pass
 
 
 def _build_adaptive(K):
@@ -230,50 +241,89 @@ def _build_adaptive_ensemble(K):
 
     @njit(forceinline=True)
     def save(j, t, x, p, ws, g, out):
-        norms, i, divergence = out
+        norms, i, divergence, trace_row = out[0], out[1], out[2], out[3]
         residual(t, x, p, ws, g)
         r = 0.0
         for l in range(ng):
             r = max(r, abs(g[l]))
         if not math.isfinite(r):
             r = math.inf
-        norms[i, j] = r
+        if trace_row[i] >= 0:
+            norms[trace_row[i], j] = r
         return not (r <= divergence)
 
-    run = _adaptive_loop(K, save, "ensemble")
+    @njit(forceinline=True)
+    def accepted_step(t, ws, out):
+        i, lt, lv, base, meas, t0, span = out[1], out[4], out[5], out[6], out[7], out[8], out[9]
+        r = 0.0
+        for l in range(ng):
+            r = max(r, abs(ws.g[l]))
+        window = min(4, int(5.0 * (t - t0) / span))
+        observe(lt, lv, base, meas, 0, i, t - t0, r, r, window)
+
+    run = _adaptive_loop(K, save, "ensemble", accepted_step)
 
     @njit(nogil=True, error_model="numpy")
-    def ensemble_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
-                        tab_c, rtol, atol, h0, max_steps, divergence, norms, x_final, status,
-                        fail_step, e0, e1, steps, nfev, lo, hi):  # fmt: skip
+    def ensemble_kernel(x0, alpha0s, t0, save_times, p, law_mat, law_scal, tab_a, tab_b,
+                        tab_bh, tab_c, rtol, atol, h0, max_steps, divergence, R, h_pred,
+                        trace_row, norms, meas, x_final, status, fail_step, e0, e1, steps,
+                        nfev, lo, hi):  # fmt: skip
         """Members ``lo … hi − 1``, each with its own step control; the buffers are
-        allocated once per call (a chunk of members), not per member."""
+        allocated once per call (a chunk of members), not per member.  Stored samples
+        and decay measures as in the fixed-step kernel (:mod:`.ensemble`); the linear
+        prediction steps ``g`` by ``R = e^{Ã h_pred}``."""
         ws = make_workspace()
         k = np.empty((tab_b.shape[0], N2))
         xs, xnew, err, g = np.empty(N2), np.empty(N2), np.empty(N2), np.empty(ng)
         x = np.empty(N2)
         counts = np.zeros(3, dtype=np.int64)
         tend = save_times[save_times.shape[0] - 1]
+        span = tend - t0
+        lt, lv, base = ladders(1)
+        rt, ry, fa, fb, lg = scratch()
+        g_p = np.empty(alpha0s.shape[1])
+        gn_p = np.empty(alpha0s.shape[1])
         for i in range(lo, hi):
             for l in range(N2):
                 x[l] = x0[i, l]
+            if trace_row[i] >= 0:
+                for s in range(norms.shape[1]):
+                    norms[trace_row[i], s] = math.nan
             if status[i] != 0:  # not placed: keep it out
                 for l in range(N2):
                     x_final[i, l] = x[l]
+                begin(lt, lv, base, meas, 0, i, math.nan, math.nan)
+                finish(lt, lv, meas, 0, i, math.nan, True, 1.0, rt, ry, fa, fb, lg)
                 continue
             e0[i] = energy(t0, x, p, ws)
+            residual(t0, x, p, ws, g)
+            r0 = 0.0
+            for l in range(ng):
+                r0 = max(r0, abs(g[l]))
+            begin(lt, lv, base, meas, 0, i, r0, r0)
             st, written = run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
                               tab_c, rtol, atol, h0, max_steps, 0, 0.0, ws, k, xs, xnew,
-                              err, g, (norms, i, divergence), counts)  # fmt: skip
+                              err, g, (norms, i, divergence, trace_row, lt, lv, base, meas,
+                                       t0, span), counts)  # fmt: skip
             for l in range(N2):
                 x_final[i, l] = x[l]
             status[i] = st
             steps[i] = counts[0]
             nfev[i] = counts[2]
+            final = math.nan
             if st != 0:
                 fail_step[i] = counts[0]
             else:
                 e1[i] = energy(tend, x, p, ws)
+                residual(tend, x, p, ws, g)
+                final = 0.0
+                for l in range(ng):
+                    final = max(final, abs(g[l]))
+            finish(lt, lv, meas, 0, i, final, st != 0, span / max(counts[0], 1), rt, ry, fa,
+                   fb, lg)  # fmt: skip
+            if R.shape[0] > 0:
+                predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt, lv, base, meas,
+                        0, i, rt, ry, fa, fb, lg, g_p, gn_p)  # fmt: skip
 
     keyed_cache(ensemble_kernel, kernel_key(K.key, "adaptive-ensemble-dopri5"))
     return ensemble_kernel

@@ -1,56 +1,170 @@
-"""Decay-rate estimation from stored residual traces.
+"""Decay rate, prefactor and floor of each member's residual, measured at every step.
 
-For each member, ``‖g(t)‖`` first decays at the rate of the law (continuous: ``−max Re λ(Ã)``;
+A member's ``‖g‖∞`` first decays at the rate of the law (continuous: ``−max Re λ(Ã)``;
 discrete: ``−ln ρ(R(τÃ))/τ``) and then settles on a floor set by the scheme's local error
-(the paper's §5).  The estimator
+(the paper's §5).  The kernels measure it at every step, not on the stored samples, with
+O(1) work per step and a fixed amount of memory per member (a *ladder*):
 
-1. takes the floor as the median of the last fifth of the trace;
-2. takes the upper envelope of the norm from the right (running maximum) and keeps only
-   the samples that lie on it, so that the dips of an oscillating residual do not drag
-   the fit down;
-3. keeps the transient: the samples from the start until the envelope first comes within
-   a factor 1000 of the floor (100, then ``FLOOR_MARGIN`` = 30 when that leaves fewer than
-   8 samples; the whole trace if it never does): the floor is a forced response that
-   bends the trace well above its own level.  An oscillating residual (under-damped laws:
-   ``OSCILLATING_PEAKS`` peaks or more above 30× the floor) is fitted on its peaks only
-   (the widest margin that leaves that many), which lie on ``c e^{−βt}``; the rest of its
-   envelope is descending arcs, steeper than the decay;
-4. the fit window is the later part of the transient (after ``LEAD_FRACTION`` of its
-   decades), where faster modes have died out; it fits ``log ‖g‖ ≈ a − β t`` and (not for
-   an oscillating residual) ``log ‖g‖ ≈ a − β t + ν log(t + s)`` by least squares,
-   ``s`` found by a grid search refined by Brent's method, and keeps the fit with the
-   smallest residual.  The ``ν log(t + s)`` term absorbs the
-   polynomial prefactor of repeated eigenvalues: critically damped Baumgarte decays like
-   ``|c0 + c1 t| e^{−ωt}`` (Euler's ``R(τÃ)`` is then a Jordan block, ``‖g_k‖ ~ |a + bk| ρ^k``),
-   i.e. ``log ‖g‖ = log c1 − ωt + log(t + c0/c1)`` with a member-dependent shift, negative
-   when ``c0 + c1 t`` crosses zero before the fit window (the grid covers both signs);
-5. reports ``γ = max_t ‖g(t)‖ e^{βt}`` over the transient, the smallest prefactor with
-   ``‖g(t)‖ ≤ γ e^{−βt}`` there.
+* the norm's level on a log scale of ``LEVELS_PER_OCTAVE`` levels per octave (read from
+  the float's exponent and leading mantissa bits: no logarithm per step), over
+  ``NBINS`` levels from ``2^-54`` to about ``940`` times the member's initial norm;
+* per level, the time and value of the *last* step at which the norm lay on it.
 
-Members with fewer than ``MIN_SAMPLES`` transient samples get ``β = γ = NaN``.
+From the ladder the estimator reads the right envelope of the whole trace at step
+resolution: the last sample on a level is a point of the envelope (no later sample is as
+large) exactly when no higher level was visited later (:func:`records`).  These points,
+one per level, are what the decay rate of an oscillating residual is read from, and they
+are the samples of a monotone one.  Also per member: the largest norm over each fifth of
+the run (``W0 … W4``); ``W4``, the largest over the last fifth, is the *floor*.
+
+The estimator (:func:`estimate`), per member, at the end of its run:
+
+1. the transient: the envelope points from the start until the envelope first comes
+   within a margin of the floor (1000, 100, then ``FLOOR_MARGIN`` = 30 when that leaves
+   too little: the floor is a forced response that bends the trace well above its own
+   level), or all of them when the run ended while the residual was still decaying (each
+   of the last three fifths at least ``STILL_DECAYING`` times below the one before);
+2. the fit window: the transient after its first ``LEAD_FRACTION`` of decades, where
+   faster modes have died out.  It must span a decade (``MIN_DECADES``) with
+   ``MIN_POINTS`` points; otherwise β is NaN with the reason ``no transient``;
+3. fits ``log ‖g‖ ≈ a − β t`` and ``log ‖g‖ ≈ a − β t + ν log(t + s)`` by least squares
+   (``s`` by a grid search refined by Brent's method) and keeps the better.  The
+   ``ν log(t + s)`` term absorbs the polynomial prefactor of repeated eigenvalues:
+   critically damped Baumgarte decays like ``|c0 + c1 t| e^{−ωt}`` (the schemes'
+   ``R(τÃ)`` is then a Jordan block, ``‖g_k‖ ~ |a + bk| ρ^k``).  When neither fits the
+   points to ``SMOOTH_RMS`` in the logarithm, the residual oscillates (under-damped laws):
+   the envelope is then ``e^{−βt}`` times a periodic function, and the time of each level
+   regressed on the level (``t ≈ a − log ‖g‖ / β``, levels equally spaced) has a bias that
+   falls like the square of the number of periods in the window;
+4. ``γ = max ‖g(t)‖ e^{βt}`` over the transient's envelope points, the smallest prefactor
+   with ``‖g(t)‖ ≤ γ e^{−βt}`` there (the largest of a trace is always on its envelope).
+
+A member that stopped, or whose envelope does not fall, gets ``β = γ = NaN`` and a reason
+(:data:`REASONS`), never a fitted number.
+
+:func:`predict` runs a member's linear prediction ``g_{k+1} = R g_k`` from its own
+``α⁰`` (``R = R(τÃ)`` for fixed steps, ``e^{Ãh}`` for adaptive ones) through the same
+ladder and fits it over the same time window with the same kind of fit, so that what the
+estimator does to a window cancels in the ratio of measured to predicted rate.
 """
 
 from __future__ import annotations
 
 import math
+import struct
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import config, njit, types
+from numba.extending import intrinsic
 
 from .threads import run_chunks
 
+#: levels of the ladder per octave (the leading mantissa bits read: 3)
+LEVELS_PER_OCTAVE = 8
+_SHIFT = 52 - 3
+#: levels of the ladder, and how many lie above the member's initial norm
+NBINS = 512
+ABOVE = 80
+_START_BIN = NBINS - 1 - ABOVE
+
 FLOOR_MARGIN = 30.0
-MIN_SAMPLES = 4
+LEAD_FRACTION = 0.3
+MIN_POINTS = 12
+MIN_DECADES = 1.0
+#: a fit whose RMS deviation in log ‖g‖ exceeds this is not of a smooth decay
+SMOOTH_RMS = 0.01
+#: the run ended inside the transient: each of the last three fifths fell by this factor
+STILL_DECAYING = 3.0
 N_SHIFTS = 16
 #: Brent's search for the shift stops within this fraction of its bracket (two grid steps)
 BRENT_TOL = 3e-5
-LEAD_FRACTION = 0.3
-#: a transient with this many peaks is oscillating and fitted on its peaks (_peak_pass)
-OSCILLATING_PEAKS = 3
-#: a peak rises this many times above the trace's lowest sample since the previous peak
-PEAK_RISE = 1.1
+
+#: columns of the per-member measurement array (``measures``)
+COLUMNS = ("beta", "gamma", "floor", "initial", "largest", "final", "w0", "w1", "w2", "w3",
+           "w4", "fit_start", "fit_end", "fit_points", "reason", "fit_kind", "shift",
+           "floor_reached", "beta_predicted", "d2", "d3", "d4")  # fmt: skip
+(C_BETA, C_GAMMA, C_FLOOR, C_INITIAL, C_LARGEST, C_FINAL, C_W0, C_W1, C_W2, C_W3, C_W4,
+ C_FIT_START, C_FIT_END, C_POINTS, C_REASON, C_KIND, C_SHIFT, C_FLOOR_REACHED,
+ C_BETA_PRED, C_D2, C_D3, C_D4) = range(len(COLUMNS))  # fmt: skip
+NCOLS = len(COLUMNS)
+
+#: reason codes of ``beta_reason``
+R_FITTED, R_NO_TRANSIENT, R_STOPPED, R_NOT_DECAYING = 0, 1, 2, 3
+REASONS = {
+    R_FITTED: "fitted",
+    R_NO_TRANSIENT: "no transient: under a decade of decay above the floor",
+    R_STOPPED: "stopped",
+    R_NOT_DECAYING: "not decaying",
+}
+#: kinds of fit (``fit_kind``)
+K_NONE, K_EXPONENTIAL, K_POLYNOMIAL, K_OSCILLATING = 0, 1, 2, 3
+KINDS = {K_NONE: "none", K_EXPONENTIAL: "exponential",
+         K_POLYNOMIAL: "exponential with polynomial prefactor",
+         K_OSCILLATING: "oscillating (level times regressed on levels)"}  # fmt: skip
 
 
+# --------------------------------------------------------------------- the ladder
+@intrinsic
+def _bits_intrinsic(typingctx, x):
+    if not (isinstance(x, types.Float) and x.bitwidth == 64):
+        return None
+
+    def codegen(context, builder, sig, args):
+        return builder.bitcast(args[0], ir.IntType(64))
+
+    return types.int64(x), codegen
+
+
+def _bits_python(x):
+    return struct.unpack("<q", struct.pack("<d", x))[0]
+
+
+float_bits = _bits_python if config.DISABLE_JIT else _bits_intrinsic
+float_bits.__doc__ = """The IEEE-754 bits of a float64 as an int64 (monotone in a
+non-negative value)."""
+
+
+@njit(cache=True, forceinline=True)
+def ladder_base(g0):
+    """The ladder's offset for a member whose initial norm is ``g0``: its level is
+    ``NBINS − 1 − ABOVE``.  (A zero or non-finite ``g0`` anchors the ladder at 1.)"""
+    ref = g0 if (g0 > 0.0 and g0 < math.inf) else 1.0
+    return (float_bits(ref) >> _SHIFT) - _START_BIN
+
+
+@njit(cache=True, forceinline=True)
+def ladder_level(v, base):
+    """The level of the norm ``v`` (≥ 0) on a ladder with offset ``base``, clamped."""
+    b = (float_bits(v) >> _SHIFT) - base
+    return min(max(b, 0), NBINS - 1)
+
+
+@njit(cache=True)
+def ladder_clear(lt, j):
+    for b in range(NBINS):
+        lt[j, b] = -1.0
+
+
+@njit(cache=True)
+def records(lt, lv, j, rt, ry):
+    """The right-envelope points of ladder row ``j``, in time order, into ``rt`` (times)
+    and ``ry`` (log norms); returns their number.  The last sample on a level lies on the
+    envelope exactly when no higher level was visited later."""
+    n = 0
+    latest = -1.0
+    for b in range(NBINS - 1, -1, -1):
+        t = lt[j, b]
+        if t > latest:
+            latest = t
+            v = lv[j, b]
+            rt[n] = t
+            ry[n] = math.log(v) if v > 0.0 else -math.inf
+            n += 1
+    return n
+
+
+# --------------------------------------------------------------------- fits
 @njit(cache=True)
 def _solve3(a, b):
     """Solve the 3×3 system ``a x = b`` by Gaussian elimination with partial pivoting;
@@ -80,92 +194,65 @@ def _solve3(a, b):
 
 
 @njit(cache=True)
-def _median(a, n):
-    """Median of ``a[:n]`` (the mean of the middle two for even ``n``), reordering ``a``
-    in place: Hoare's selection, O(n), the same value as sorting (a sort was a third of
-    the fit's time)."""
-    k = n // 2
-    lo, hi = 0, n - 1
-    while lo < hi:
-        mid = (lo + hi) // 2  # median of three as the pivot
-        if a[mid] < a[lo]:
-            a[mid], a[lo] = a[lo], a[mid]
-        if a[hi] < a[lo]:
-            a[hi], a[lo] = a[lo], a[hi]
-        if a[hi] < a[mid]:
-            a[hi], a[mid] = a[mid], a[hi]
-        pivot = a[mid]
-        i, j = lo, hi
-        while i <= j:
-            while a[i] < pivot:
-                i += 1
-            while a[j] > pivot:
-                j -= 1
-            if i <= j:
-                a[i], a[j] = a[j], a[i]
-                i += 1
-                j -= 1
-        if k <= j:
-            hi = j
-        elif k >= i:
-            lo = i
-        else:
-            break
-    if n % 2 == 1:
-        return a[k]
-    below = a[0]  # a[:k] holds the k smallest: the lower middle is their largest
-    for i in range(1, k):
-        below = max(below, a[i])
-    return 0.5 * (below + a[k])
-
-
-@njit(cache=True)
-def _fit_linear(env, on_env, times, start, end):
-    """Least squares ``env ≈ c − β t`` on samples [start, end); returns (β, SSE)."""
-    st = sy = stt = sty = 0.0
-    cnt = 0
+def _fit_linear(rt, ry, start, end):
+    """Least squares ``y ≈ c − β t`` on points [start, end); returns (β, SSE)."""
+    cnt = end - start
+    st = sy = 0.0
     for i in range(start, end):
-        if not on_env[i]:
-            continue
-        cnt += 1
-        t = times[i] - times[0]
-        st += t
-        sy += env[i]
-        stt += t * t
-        sty += t * env[i]
-    slope = (cnt * sty - st * sy) / (cnt * stt - st * st)
-    icpt = (sy - slope * st) / cnt
+        st += rt[i]
+        sy += ry[i]
+    tm, ym = st / cnt, sy / cnt
+    stt = sty = 0.0
+    for i in range(start, end):
+        stt += (rt[i] - tm) ** 2
+        sty += (rt[i] - tm) * (ry[i] - ym)
+    if stt == 0.0:
+        return math.nan, math.inf
+    slope = sty / stt
     sse = 0.0
     for i in range(start, end):
-        if not on_env[i]:
-            continue
-        r = env[i] - icpt - slope * (times[i] - times[0])
+        r = ry[i] - ym - slope * (rt[i] - tm)
         sse += r * r
     return -slope, sse
 
 
 @njit(cache=True)
-def _fit_with_log(env, on_env, times, start, end, shift, a, b, lg):
-    """Least squares ``env ≈ c − β t + ν log(t + shift)`` on [start, end); returns (β, SSE),
-    SSE = inf when the normal equations are singular.  ``lg`` is scratch (the logarithms,
-    taken once for both passes)."""
+def _fit_inverse(rt, ry, start, end):
+    """Least squares ``t ≈ a + b y`` on [start, end); returns ``β = −1/b``."""
+    cnt = end - start
+    st = sy = 0.0
+    for i in range(start, end):
+        st += rt[i]
+        sy += ry[i]
+    tm, ym = st / cnt, sy / cnt
+    syy = sty = 0.0
+    for i in range(start, end):
+        syy += (ry[i] - ym) ** 2
+        sty += (rt[i] - tm) * (ry[i] - ym)
+    if sty == 0.0:
+        return math.nan
+    return -syy / sty
+
+
+@njit(cache=True)
+def _fit_with_log(rt, ry, start, end, shift, a, b, lg):
+    """Least squares ``y ≈ c − β t + ν log(t + shift)`` on [start, end); returns (β, SSE),
+    SSE = inf when the normal equations are singular.  ``lg`` is scratch."""
     a[:, :] = 0.0
     b[:] = 0.0
     for i in range(start, end):
-        if not on_env[i]:
-            continue
-        t = times[i] - times[0]
+        t = rt[i]
         lg[i] = math.log(t + shift)
-        r0, r1, r2 = 1.0, -t, lg[i]
-        a[0, 0] += r0 * r0
-        a[0, 1] += r0 * r1
-        a[0, 2] += r0 * r2
+        r1, r2 = -t, lg[i]
+        a[0, 0] += 1.0
+        a[0, 1] += r1
+        a[0, 2] += r2
         a[1, 1] += r1 * r1
         a[1, 2] += r1 * r2
         a[2, 2] += r2 * r2
-        b[0] += r0 * env[i]
-        b[1] += r1 * env[i]
-        b[2] += r2 * env[i]
+        b[0] += ry[i]
+        b[1] += r1 * ry[i]
+        b[2] += r2 * ry[i]
     a[1, 0] = a[0, 1]
     a[2, 0] = a[0, 2]
     a[2, 1] = a[1, 2]
@@ -173,57 +260,17 @@ def _fit_with_log(env, on_env, times, start, end, shift, a, b, lg):
         return math.nan, math.inf
     sse = 0.0
     for i in range(start, end):
-        if not on_env[i]:
-            continue
-        t = times[i] - times[0]
-        r = env[i] - b[0] + b[1] * t - b[2] * lg[i]
+        r = ry[i] - b[0] + b[1] * rt[i] - b[2] * lg[i]
         sse += r * r
     return b[1], sse
 
 
 @njit(cache=True)
-def _peak_pass(norm, on_env, end, apply):
-    """Count the peaks of the transient ``norm[:end]``: samples on the upper envelope
-    that the trace reaches by rising at least ``PEAK_RISE`` times above its lowest
-    sample since the previous peak (not a wiggle of the floor).  With ``apply``, the
-    other samples are taken off the envelope.
-
-    The peaks of an oscillating residual lie on ``c e^{−βt}`` up to the sampling of the
-    period; the rest of its envelope is descending arcs, steeper than ``e^{−βt}``, which
-    pulled the fit off by up to a factor of several (under-damped Baumgarte, ξ = 0.7).
-    A decay without oscillation has at most one such peak per component of ``g``."""
-    count = 0
-    low = math.inf
-    for i in range(1, end):
-        low = min(low, norm[i - 1])
-        peak = on_env[i] and norm[i] >= norm[i - 1] and norm[i] >= PEAK_RISE * low
-        if peak:
-            count += 1
-            low = math.inf
-        if apply:
-            on_env[i] = peak
-    if apply:
-        on_env[0] = False
-    return count
-
-
-@njit(cache=True)
-def _transient_end(env, nvalid, level):
-    """The first sample (from 1) at which the envelope is down to ``level``; ``nvalid``
-    when it never is."""
-    for i in range(1, nvalid):
-        if env[i] <= level:
-            return i
-    return nvalid
-
-
-@njit(cache=True)
-def _brent(env, on_env, times, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg):
+def _brent(rt, ry, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg):
     """Brent's minimization (parabolic steps, golden sections when they fail) of the
     ``ν log(t + s)`` fit's SSE over ``u = log(s + t_w)`` in ``[lo_u, hi_u]``, from the
     grid's best point ``x`` (SSE ``fx``, β ``bx``), to ``BRENT_TOL`` of the bracket.
-    Returns the smallest SSE seen and its β.  (Golden sections alone took 22 fits to a
-    comparable bracket; the fit's time is mostly these fits' logarithms.)"""
+    Returns the smallest SSE seen, its β and its ``u``."""
     CG = 0.3819660112501051
     tol1 = BRENT_TOL * (hi_u - lo_u)
     tol2 = 2.0 * tol1
@@ -231,7 +278,7 @@ def _brent(env, on_env, times, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg)
     w = v = x
     fw = fv = fx
     d = e = 0.0
-    best, beta = fx, bx
+    best, beta, ubest = fx, bx, x
     for _ in range(40):
         xm = 0.5 * (lo + hi)
         if abs(x - xm) <= tol2 - 0.5 * (hi - lo):
@@ -257,9 +304,9 @@ def _brent(env, on_env, times, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg)
             e = (lo - x) if x >= xm else (hi - x)
             d = CG * e
         u = x + d if abs(d) >= tol1 else x + (tol1 if d >= 0.0 else -tol1)
-        bu, fu = _fit_with_log(env, on_env, times, start, end, math.exp(u) - t_w, a, b, lg)
+        bu, fu = _fit_with_log(rt, ry, start, end, math.exp(u) - t_w, a, b, lg)
         if fu < best:
-            best, beta = fu, bu
+            best, beta, ubest = fu, bu, u
         if fu <= fx:
             if u >= x:
                 lo = x
@@ -278,206 +325,309 @@ def _brent(env, on_env, times, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg)
                 w, fw = u, fu
             elif fu <= fv or v == x or v == w:
                 v, fv = u, fu
-    return best, beta
+    return best, beta, ubest
 
 
 @njit(cache=True)
-def _fit_one(norm, nvalid, times, env, on_env, tail, lg, a, b, out):
-    """Fit one trace; writes (β, γ, floor, transient samples) into ``out``.  ``env``,
-    ``on_env``, ``tail``, ``lg`` (samples), ``a`` (3 × 3) and ``b`` (3) are scratch.
-    Returns the largest of ``norm[:nvalid]`` (−inf when ``nvalid`` is 0)."""
-    out[0] = math.nan
-    out[1] = math.nan
-    out[2] = math.nan
-    out[3] = 0.0
-    if nvalid < 2:
-        return norm[0] if nvalid == 1 else -math.inf
-    ntail = min(max(3, nvalid // 5), nvalid)
-    for i in range(ntail):
-        tail[i] = norm[nvalid - ntail + i]
-    floor = _median(tail, ntail)
-    out[2] = floor
-    # upper envelope of ‖g‖ from the right: non-increasing, blind to the dips of an
-    # oscillating residual; its logarithm is taken below, on the transient only
-    top = -math.inf  # the largest sample so far
-    for i in range(nvalid - 1, -1, -1):
-        y = norm[i]
-        on_env[i] = y >= top  # a "record" from the right: on the upper hull of the trace
-        top = max(top, y)
-        env[i] = top
-    largest = top
-    # transient: until the envelope comes within a margin of the floor.  The floor is a
-    # forced response, not noise, and bends the trace well above it: take the widest
-    # margin (1000, 100, then FLOOR_MARGIN) that still leaves 8 samples, or for an
-    # oscillating residual (OSCILLATING_PEAKS peaks above the narrowest) that many peaks,
-    # and fit an oscillating one on its peaks only (_peak_pass).
-    oscillating = _peak_pass(norm, on_env, _transient_end(env, nvalid, FLOOR_MARGIN * floor),
-                             False) >= OSCILLATING_PEAKS  # fmt: skip
-    end = nvalid
-    for margin in (1000.0, 100.0, FLOOR_MARGIN):
-        end = _transient_end(env, nvalid, margin * floor)
-        if oscillating:
-            if _peak_pass(norm, on_env, end, False) >= OSCILLATING_PEAKS:
+def _fit_polynomial(rt, ry, start, end, dt, a, b, lg):
+    """The ``ν log(t + s)`` fit with the best shift: a log-spaced grid of shifts
+    ``s = e^u − t_w`` over ``(−t_w, ∞)`` (``t_w`` the window's first time: a negative
+    ``s`` puts a zero crossing of ``c0 + c1 t`` just before the window), refined by
+    Brent's method around the best grid point.  Returns (β, SSE, s)."""
+    t_w = rt[start]
+    span = rt[end - 1] - t_w
+    lo = math.log(0.25 * dt)
+    hi = math.log(t_w + 4.0 * span + dt)
+    step_u = (hi - lo) / (N_SHIFTS - 1)
+    k_best = -1
+    best, beta = math.inf, math.nan
+    for k in range(N_SHIFTS):
+        u = lo + k * step_u
+        bk, sse = _fit_with_log(rt, ry, start, end, math.exp(u) - t_w, a, b, lg)
+        if sse < best:
+            best, beta, k_best = sse, bk, k
+    if k_best < 0:
+        return math.nan, math.inf, math.nan
+    ua = lo + max(k_best - 1, 0) * step_u
+    ub = lo + min(k_best + 1, N_SHIFTS - 1) * step_u
+    best, beta, u = _brent(rt, ry, start, end, t_w, ua, ub, lo + k_best * step_u, best, beta,
+                           a, b, lg)  # fmt: skip
+    return beta, best, math.exp(u) - t_w
+
+
+@njit(cache=True)
+def _window(rt, ry, n, floor, still_decaying):
+    """The fit window ``[start, end)`` of the envelope points: the transient (down to a
+    margin above the floor, or all points when the run ended still decaying) after its
+    first ``LEAD_FRACTION`` of decades.  ``end`` is 0 when no window spans
+    ``MIN_DECADES`` with ``MIN_POINTS`` points."""
+    lnfloor = math.log(floor) if floor > 0.0 else -math.inf
+    for margin in (1000.0, 100.0, FLOOR_MARGIN, -1.0):
+        if margin < 0.0:
+            if not still_decaying:
                 break
-        elif end >= 8:
-            break
-    out[3] = end
-    if oscillating:
-        _peak_pass(norm, on_env, end, True)
-    for i in range(end):  # the fits work on log ‖g‖
-        env[i] = math.log(env[i]) if env[i] > 0.0 else -math.inf
-    if end < MIN_SAMPLES or not math.isfinite(env[end - 1]):
-        return largest
-    # fit window: the later part of the transient, after LEAD_FRACTION of its decades,
-    # where faster modes have died out and the decay runs at the asymptotic rate
-    cut = env[0] - LEAD_FRACTION * (env[0] - env[end - 1])
-    start = 0
-    for i in range(end):
-        if env[i] <= cut:
-            start = i
-            break
-    npts = 0
-    for i in range(start, end):
-        npts += on_env[i]
-    while npts < MIN_SAMPLES and start > 0:
-        start -= 1
-        npts += on_env[start]
-    if npts < 2:
-        return largest
-    dt = times[1] - times[0]
-    span = times[end - 1] - times[0]
-    # plain exponential (ν = 0), then ν log(t + s) over a log-spaced grid of shifts s
-    beta, best = _fit_linear(env, on_env, times, start, end)
-    if npts >= 6 and not oscillating:  # (the peaks lie on e^{−βt}: ν log would fit jitter)
-        # shifts s = e^u − t_w over (−t_w, ∞), t_w the window's first time: a negative s
-        # puts a zero crossing of c0 + c1 t just before the window.  Grid in u, then a
-        # refinement by Brent's method around the best grid point.
-        t_w = times[start] - times[0]
-        lo = math.log(0.25 * dt)
-        hi = math.log(t_w + 4.0 * span + dt)
-        step_u = (hi - lo) / (N_SHIFTS - 1)
-        k_best = -1
-        for k in range(N_SHIFTS):
-            u = lo + k * step_u
-            bk, sse = _fit_with_log(env, on_env, times, start, end, math.exp(u) - t_w, a, b, lg)
-            if sse < best:
-                best, beta, k_best = sse, bk, k
-        if k_best >= 0:
-            ua = lo + max(k_best - 1, 0) * step_u
-            ub = lo + min(k_best + 1, N_SHIFTS - 1) * step_u
-            best, beta = _brent(env, on_env, times, start, end, t_w, ua, ub,
-                                lo + k_best * step_u, best, beta, a, b, lg)
+            end = n
+        else:
+            level = lnfloor + math.log(margin)
+            end = n
+            for i in range(n):
+                if ry[i] <= level:
+                    end = i
+                    break
+        if end < 2:
+            continue
+        cut = ry[0] - LEAD_FRACTION * (ry[0] - ry[end - 1])
+        start = 0
+        for i in range(end):
+            if ry[i] <= cut:
+                start = i
+                break
+        if (end - start >= MIN_POINTS
+                and ry[start] - ry[end - 1] >= MIN_DECADES * math.log(10.0)):
+            return start, end
+    return 0, 0
+
+
+@njit(cache=True)
+def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out):
+    """β, γ and the fit's window, kind and shift from the ``n`` envelope points into
+    ``out`` (columns of :data:`COLUMNS`; ``reason`` too)."""
+    out[C_BETA] = math.nan
+    out[C_GAMMA] = math.nan
+    out[C_FIT_START] = math.nan
+    out[C_FIT_END] = math.nan
+    out[C_POINTS] = 0
+    out[C_KIND] = K_NONE
+    out[C_SHIFT] = math.nan
+    if n < 2 or not math.isfinite(ry[0]):
+        out[C_REASON] = R_NOT_DECAYING if n < 2 else R_NO_TRANSIENT
+        return
+    start, end = _window(rt, ry, n, floor, still_decaying)
+    if end == 0:
+        # no decade of decay above the floor: growing (the largest norm of each of the
+        # last three fifths larger, doubling from the third), or started near its floor
+        growing = (out[C_D4] > 2.0 * out[C_D2] and out[C_D4] >= out[C_D3] >= out[C_D2])
+        out[C_REASON] = R_NOT_DECAYING if growing else R_NO_TRANSIENT
+        return
+    beta, sse = _fit_linear(rt, ry, start, end)
+    kind = K_EXPONENTIAL
+    shift = math.nan
+    if end - start >= 6:
+        bp, sp, s = _fit_polynomial(rt, ry, start, end, dt, a, b, lg)
+        if sp < sse:
+            beta, sse, kind, shift = bp, sp, K_POLYNOMIAL, s
+    if math.sqrt(sse / (end - start)) > SMOOTH_RMS:
+        beta = _fit_inverse(rt, ry, start, end)
+        kind = K_OSCILLATING
+        shift = math.nan
+    out[C_FIT_START] = rt[start]
+    out[C_FIT_END] = rt[end - 1]
+    out[C_POINTS] = end - start
+    out[C_KIND] = kind
+    out[C_SHIFT] = shift
+    if not (beta > 0.0):
+        out[C_REASON] = R_NOT_DECAYING
+        return
     gamma = 0.0
     for i in range(end):
-        g = norm[i] * math.exp(beta * (times[i] - times[0]))
-        if g > gamma:
-            gamma = g
-    out[0] = beta
-    out[1] = gamma
-    return largest
+        gamma = max(gamma, math.exp(ry[i] + beta * rt[i]))
+    out[C_BETA] = beta
+    out[C_GAMMA] = gamma
+    out[C_REASON] = R_FITTED
 
 
+@njit(cache=True)
+def refit(rt, ry, n, t_lo, t_hi, kind, dt, a, b, lg):
+    """β of the envelope points with times in ``[t_lo, t_hi]`` by the fit ``kind`` (the
+    measured member's window and kind, for its prediction)."""
+    start, end = n, 0
+    for i in range(n):
+        if rt[i] >= t_lo and start == n:
+            start = i
+        if rt[i] <= t_hi:
+            end = i + 1
+    if end - start < 3:
+        return math.nan
+    if kind == K_EXPONENTIAL:
+        return _fit_linear(rt, ry, start, end)[0]
+    if kind == K_POLYNOMIAL:
+        return _fit_polynomial(rt, ry, start, end, dt, a, b, lg)[0]
+    if kind == K_OSCILLATING:
+        return _fit_inverse(rt, ry, start, end)
+    return math.nan
+
+
+# --------------------------------------------------------------------- per member
+@njit(cache=True)
+def observe(lt, lv, base, meas, j, row, t, v, d, window):
+    """Step time ``t`` (from the start) of member ``row`` (ladder row ``j``), in fifth
+    ``window`` of the run: ``v`` its residual norm (the largest per fifth is kept), ``d``
+    the norm whose decay is measured (the ladder's; ``v`` itself, or the distance of the
+    residual from a reference trajectory's).  Non-finite norms are left out."""
+    if v < math.inf:
+        c = C_W0 + window
+        if not (meas[row, c] >= v):
+            meas[row, c] = v
+    if d < math.inf:
+        b = ladder_level(d, base[j])
+        lt[j, b] = t
+        lv[j, b] = d
+        if window >= 2:
+            c = C_D2 + window - 2
+            if not (meas[row, c] >= d):
+                meas[row, c] = d
+
+
+@njit(cache=True)
+def begin(lt, lv, base, meas, j, row, g0, d0):
+    """Start member ``row`` on ladder row ``j`` with its initial norms (as
+    :func:`observe`'s)."""
+    ladder_clear(lt, j)
+    base[j] = ladder_base(d0)
+    for c in range(NCOLS):
+        meas[row, c] = math.nan
+    for w in range(5):
+        meas[row, C_W0 + w] = -math.inf
+    for w in range(3):
+        meas[row, C_D2 + w] = -math.inf
+    meas[row, C_INITIAL] = g0
+    observe(lt, lv, base, meas, j, row, 0.0, g0, d0, 0)
+
+
+@njit(cache=True)
+def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
+    """Member ``row``'s measures from ladder row ``j`` at the end of its run (``final``:
+    the norm at its last state; ``stopped``: it did not run to the end)."""
+    out = meas[row]
+    out[C_FINAL] = final
+    largest = -math.inf
+    for w in range(5):
+        if out[C_W0 + w] == -math.inf:
+            out[C_W0 + w] = math.nan
+        else:
+            largest = max(largest, out[C_W0 + w])
+    out[C_LARGEST] = largest if largest > -math.inf else math.nan
+    out[C_FLOOR] = out[C_W4]
+    # the measured norm's own floor and whether it is still falling at the end
+    floor = out[C_D4]
+    still = (out[C_D2] >= STILL_DECAYING * out[C_D3]
+             and out[C_D3] >= STILL_DECAYING * out[C_D4])  # fmt: skip
+    out[C_FLOOR_REACHED] = 0.0 if still else 1.0
+    if stopped:
+        for c in (C_BETA, C_GAMMA, C_FIT_START, C_FIT_END, C_SHIFT):
+            out[c] = math.nan
+        out[C_POINTS] = 0
+        out[C_KIND] = K_NONE
+        out[C_REASON] = R_STOPPED
+        return
+    n = records(lt, lv, j, rt, ry)
+    estimate(rt, ry, n, floor, still, dt, a, b, lg, out)
+
+
+@njit(cache=True)
+def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g, gn):
+    """Member ``row``'s predicted rate: ``g_{k+1} = R g_k`` from ``g_0 = alpha`` over the
+    steps up to its fit window's end, through ladder row ``j``, fitted over the measured
+    window with the measured kind.  ``g``, ``gn`` are scratch of the residual's size."""
+    out = meas[row]
+    out[C_BETA_PRED] = math.nan
+    if out[C_REASON] != R_FITTED:
+        return
+    ng = alpha.shape[0]
+    ladder_clear(lt, j)
+    nrm = 0.0
+    for i in range(ng):
+        g[i] = alpha[i]
+        nrm = max(nrm, abs(g[i]))
+    base[j] = ladder_base(nrm)
+    t_hi = out[C_FIT_END]
+    last = min(nsteps, int(math.ceil(t_hi / h - 1e-9)) + 1)
+    for k in range(last + 1):
+        if k > 0:
+            nrm = 0.0
+            for r in range(ng):
+                s = 0.0
+                for c in range(ng):
+                    s += R[r, c] * g[c]
+                gn[r] = s
+            for r in range(ng):
+                g[r] = gn[r]
+                nrm = max(nrm, abs(gn[r]))
+        if nrm < math.inf:
+            lev = ladder_level(nrm, base[j])
+            lt[j, lev] = k * h
+            lv[j, lev] = nrm
+    n = records(lt, lv, j, rt, ry)
+    out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, out[C_KIND], h, a, b, lg)
+
+
+@njit(cache=True)
+def ladders(rows):
+    """Ladder buffers (times, values, offsets) for ``rows`` members at a time."""
+    lt = np.empty((rows, NBINS))
+    lv = np.empty((rows, NBINS))
+    base = np.zeros(rows, dtype=np.int64)
+    return lt, lv, base
+
+
+@njit(cache=True)
+def scratch():
+    """The estimator's buffers for one thread: envelope times and log norms, the normal
+    equations of the 3-parameter fit, logarithms."""
+    return np.empty(NBINS), np.empty(NBINS), np.empty((3, 3)), np.empty(3), np.empty(NBINS)
+
+
+# --------------------------------------------------------------------- stored traces
 @njit(nogil=True, cache=True)
-def summarize_rows(norms, times, r0, r1, nvalid, largest, last, fit, do_fit):
-    """Rows ``r0 … r1 − 1`` of the stored traces ``norms`` (members × samples): the
-    number of leading finite samples, the largest finite sample (NaN when the first is
-    not finite), the last of the leading finite ones, and with ``do_fit`` the decay fit
-    into ``fit[j]`` (β, γ, floor, transient samples).  One thread; the ensemble runs it
-    on each chunk of members right after integrating it (:mod:`.threads`)."""
+def _measure_rows(norms, times, meas, R, alphas, lo, hi):
+    lt, lv, base = ladders(1)
+    rt, ry, a, b, lg = scratch()
     T = norms.shape[1]
-    row = np.empty(T)
-    env = np.empty(T)
-    on_env = np.empty(T, dtype=np.bool_)
-    tail = np.empty(T)
-    lg = np.empty(T)
-    a = np.empty((3, 3))
-    b = np.empty(3)
-    for j in range(r0, r1):
-        bad = False  # a non-finite sample (one vectorized pass; most traces have none)
-        for i in range(T):
-            v = norms[j, i]
-            row[i] = v
-            bad |= not math.isfinite(v)
-        n = T
-        top = -math.inf
-        if bad or not do_fit:
-            for i in range(T):
-                v = row[i]
-                if math.isfinite(v):
-                    top = max(top, v)
-                elif n == T:
-                    n = i
-        if do_fit:  # (the fit's envelope gives the largest sample of a finite trace)
-            top_fit = _fit_one(row, n, times, env, on_env, tail, lg, a, b, fit[j])
-            if not bad:
-                top = top_fit
-        nvalid[j] = n
-        largest[j] = top if n > 0 else math.nan
-        last[j] = row[max(n - 1, 0)]
+    span = times[T - 1] - times[0]
+    dt = times[1] - times[0] if T > 1 else 1.0
+    g = np.empty(alphas.shape[1])
+    gn = np.empty(alphas.shape[1])
+    for r in range(lo, hi):
+        begin(lt, lv, base, meas, 0, r, norms[r, 0], norms[r, 0])
+        last = norms[r, 0]
+        stopped = False
+        for i in range(1, T):
+            v = norms[r, i]
+            if not math.isfinite(v):
+                stopped = True
+                break
+            w = min(4, int(5.0 * (times[i] - times[0]) / span)) if span > 0.0 else 4
+            observe(lt, lv, base, meas, 0, r, times[i] - times[0], v, v, w)
+            last = v
+        finish(lt, lv, meas, 0, r, last, stopped, dt, rt, ry, a, b, lg)
+        if R.shape[0] > 0:
+            predict(R, alphas[r], T - 1, dt, lt, lv, base, meas, 0, r, rt, ry, a, b, lg,
+                    g, gn)  # fmt: skip
 
 
-class Summary:
-    """Output arrays of :func:`summarize_rows` for ``members`` traces."""
-
-    def __init__(self, members: int):
-        self.nvalid = np.empty(members, dtype=np.int64)
-        self.largest = np.empty(members)
-        self.last = np.empty(members)
-        self.fit = np.empty((members, 4))
-
-    def rows(self, norms, times, r0: int, r1: int, do_fit: bool = True) -> None:
-        """Summarize (and fit) rows ``r0 … r1 − 1``; releases the GIL."""
-        summarize_rows(norms, times, r0, r1, self.nvalid, self.largest, self.last, self.fit,
-                       do_fit)  # fmt: skip
-
-    @property
-    def beta(self):
-        return self.fit[:, 0]
-
-    @property
-    def gamma(self):
-        return self.fit[:, 1]
-
-    @property
-    def floor(self):
-        return self.fit[:, 2]
-
-
-def _summarize(norms, times, do_fit: bool) -> Summary:
-    norms = np.ascontiguousarray(np.atleast_2d(norms))
-    times = np.ascontiguousarray(times, dtype=np.float64)
-    out = Summary(norms.shape[0])
-    run_chunks(lambda lo, hi: out.rows(norms, times, lo, hi, do_fit), norms.shape[0])
-    return out
-
-
-def trace_summary(norms):
-    """Per trace, in one compiled call: the number of leading finite samples, the largest
-    finite sample (NaN when the first is not finite) and the last of the leading finite
-    ones.  (Two passes over each row: :func:`summarize_rows` copies it first, for the fit
-    it runs without here.)
-
-    The same numbers as ``isfinite`` / ``argmin`` / ``nanmax`` over the whole array, which
-    made up most of the time spent after the integration of a large ensemble.
-    """
-    out = _summarize(norms, np.zeros(1), False)
-    return out.nvalid, out.largest, out.last
-
-
-def fit_decay(norms, times):
-    """β, γ, floor and transient length for each trace.
+def measure_traces(norms, times, R=None, alpha0=None):
+    """The measures of :data:`COLUMNS` for stored traces, each sample taken as a step.
 
     Parameters
     ----------
     norms : array (members, samples)
-        Residual norms ``‖g(t_i)‖`` (float32 or float64); NaN after a divergence (the
-        fit uses the leading finite samples).
+        ``‖g(t_i)‖``; a non-finite sample ends the trace (a stop).
     times : array (samples,)
         Uniformly spaced sample times.
+    R, alpha0 : arrays (ng, ng) and (members, ng), optional
+        The one-sample propagator of the linear prediction and each member's ``g(t_0)``:
+        fills ``beta_predicted``.
 
     Returns
     -------
-    beta, gamma, floor, n_transient : arrays (members,)
+    array (members, len(COLUMNS))
     """
-    fit = _summarize(norms, times, True).fit
-    return fit[:, 0], fit[:, 1], fit[:, 2], fit[:, 3].astype(np.int64)
+    norms = np.ascontiguousarray(np.atleast_2d(norms), dtype=np.float64)
+    times = np.ascontiguousarray(times, dtype=np.float64)
+    M = norms.shape[0]
+    R = np.zeros((0, 0)) if R is None else np.ascontiguousarray(R, dtype=np.float64)
+    alphas = (np.zeros((M, 1)) if alpha0 is None
+              else np.ascontiguousarray(np.atleast_2d(alpha0), dtype=np.float64))  # fmt: skip
+    meas = np.empty((M, NCOLS))
+    run_chunks(lambda lo, hi: _measure_rows(norms, times, meas, R, alphas, lo, hi), M)
+    return meas

@@ -56,6 +56,7 @@ from numba import njit
 
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
+from .decay import begin, finish, ladders, observe, predict, scratch
 from .fma import fma
 from .rhs import kernels_for
 from .source import exec_source
@@ -86,8 +87,11 @@ def tableau_pattern(scheme) -> tuple:
 def _member_step_source(pattern) -> str:
     """Python source of one member's explicit Runge–Kutta step with the stages written
     out, the zero terms of ``pattern`` left out and the factors equal to one dropped.
-    It returns the worst status of its right-hand sides; the new state's finiteness is
-    left to the kernel's checks (a non-finite state stays non-finite).
+    It returns the worst status of its right-hand sides, ``‖g‖∞`` and ``‖g − gref‖∞`` at
+    the step's start (read from the first stage's evaluation, for the decay measurement at
+    every step); the
+    new state's finiteness is left to the kernel's checks (a non-finite state stays
+    non-finite).
 
     Written out rather than looped, so that the body has no inner loops left around the
     inlined right-hand sides and the member loop around it vectorizes for any number of
@@ -117,7 +121,8 @@ def _member_step_source(pattern) -> str:
                 e = f"({e} + k{s}[l])" if b_kind[s] == 1 else f"fma(tab_b[{s}], k{s}[l], {e})"
         return e or "-0.0"
 
-    lines = ["def member_step(t, xk, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, xs, xn):"]
+    lines = ["def member_step(t, xk, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, xs, xn,",
+             "                gref):"]
     lines += [f"    k{s} = stack1(N2)" for s in range(stages)]
     for s in range(stages):
         arg = "xk"
@@ -127,19 +132,23 @@ def _member_step_source(pattern) -> str:
         lines.append(
             f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg}, p, law_mat, law_scal, ws, k{s})"
         )
+        if s == 0:  # ‖g(x_k)‖∞ and ‖g(x_k) − g_ref‖∞: the first stage has just evaluated g
+            lines += ["    gnorm = 0.0", "    dnorm = 0.0", "    for l in range(NG):",
+                      "        gnorm = max(gnorm, abs(ws.g[l]))",
+                      "        dnorm = max(dnorm, abs(ws.g[l] - gref[l]))"]
     lines += [
         "    for l in range(N2):",
         f"        xn[l] = fma(tau, {weights()}, xk[l])",
         "    return " + ("max(" + ", ".join(f"c{s}" for s in range(stages)) + ")"
-                        if stages > 1 else "c0"),
+                        if stages > 1 else "c0") + ", gnorm, dnorm",
     ]  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
-def _member_step(rhs, N2: int, pattern):
+def _member_step(rhs, N2: int, NG: int, pattern):
     label = "member_step_" + "".join(map(str, sum(pattern[0], ()) + pattern[1]))
     ns = exec_source(_member_step_source(pattern), label,
-                     {"rhs": rhs, "stack1": stack1, "N2": N2, "fma": fma})  # fmt: skip
+                     {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": NG, "fma": fma})  # fmt: skip
     return njit(forceinline=True, error_model="numpy")(ns["member_step"])
 
 
@@ -167,14 +176,14 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     S_ = len(pattern[1])
     NP = max(n_params, 1)
     LR, LC = law_shape
-    member_step = _member_step(rhs, N2, pattern)
+    member_step = _member_step(rhs, N2, ng, pattern)
     stack_workspace = K.stack_workspace
 
     @njit(error_model="numpy")
-    def block_norms(X, t, p, nrm):
-        """``‖g‖∞`` of every slot of the block at time ``t`` into ``nrm``: one loop over
-        the slots, vectorized like the step's (cheaper than one scalar evaluation per
-        running member)."""
+    def block_norms(X, t, p, gref, nrm, dnrm):
+        """``‖g‖∞`` and ``‖g − gref‖∞`` of every slot of the block at time ``t`` into
+        ``nrm`` and ``dnrm``: one loop over the slots, vectorized like the step's (cheaper
+        than one scalar evaluation per running member)."""
         for j in range(B):
             ws = stack_workspace()
             xs = stack1(N2)
@@ -183,9 +192,12 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 xs[l] = X[l, j]
             residual(t, xs, p, ws, gj)
             s = 0.0
+            d = 0.0
             for l in range(ng):
                 s = max(s, abs(gj[l]))
+                d = max(d, abs(gj[l] - gref[l]))
             nrm[j] = s
+            dnrm[j] = d
 
     @njit(error_model="numpy")
     def retire(X, j, row, active, code, x_final, x_last):
@@ -242,15 +254,20 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         return bad
 
     @njit(nogil=True, error_model="numpy")
-    def soa_kernel(x0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a, tab_b, tab_c,
-                   threshold, out_norm, x_final, status, fail_step, e0, e1,
-                   b_lo, b_hi):  # fmt: skip
+    def soa_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
+                   tab_b, tab_c, threshold, g_ref, R, trace_row, out_norm, meas, x_final,
+                   status, fail_step, e0, e1, b_lo, b_hi):  # fmt: skip
         """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
-        :func:`stabdae.ensemble`.  Every output row of the blocks is written here
-        (``out_norm`` NaN after a stop, ``status`` 0 and ``fail_step`` −1 for a member
-        that runs to the end), so the driver allocates them empty and the pages of the
-        large ``out_norm`` are first touched by the threads that fill them.  Releases the
-        GIL (run by :func:`.threads.run_chunks`)."""
+        :func:`stabdae.ensemble`.  Member ``i``'s stored samples go to row
+        ``trace_row[i]`` of ``out_norm`` (none when −1); its decay measures
+        (:mod:`.decay`, from ``‖g‖`` at every step) to row ``i`` of ``meas``, with the
+        linear prediction ``g_{k+1} = R g_k`` from ``alpha0s[i]`` when ``R`` is not
+        empty.  The decay is measured on ``‖g_k − g_ref[k]‖∞``, ``g_ref`` the residual of a
+        reference trajectory at every step (none when it has no rows: ``‖g_k‖∞``).
+        Every output row of the blocks is written here (``out_norm`` NaN after a stop,
+        ``status`` 0 and ``fail_step`` −1 for a member that runs to the end), so the
+        driver allocates them empty and the pages are first touched by the threads
+        that fill them.  Releases the GIL (run by :func:`.threads.run_chunks`)."""
         M = x0s.shape[0]
         nsave = out_norm.shape[1]
         # The small run-time inputs copied to the stack, so that the loops read memory no
@@ -283,6 +300,16 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         ws_h = K_make_workspace()
         xs_h = np.empty(N2)
         nrm_b = np.empty(B)  # the block's residual norms at a stored sample
+        gn_b = np.empty(B)  # ... at the start of the current step
+        dn_b = np.empty(B)  # ... and their distances from the reference's
+        has_ref = g_ref.shape[0] > 0
+        gr = stack1(ng)  # the reference's residual at the current step
+        for l in range(ng):
+            gr[l] = 0.0
+        lt, lv, base = ladders(B)  # the decay measurement's ladder per slot
+        rt, ry, fa, fb, lg = scratch()
+        g_p = np.empty(alpha0s.shape[1])
+        gn_p = np.empty(alpha0s.shape[1])
         for b in range(b_lo, b_hi):
             lo = b * B
             cnt = min(B, M - lo)
@@ -295,16 +322,23 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             for j in range(cnt):
                 status[lo + j] = 0
                 fail_step[lo + j] = -1
-                for s in range(nsave):
-                    out_norm[lo + j, s] = math.nan
+                r = trace_row[lo + j]
+                if r >= 0:
+                    for s in range(nsave):
+                        out_norm[r, s] = math.nan
             alive = 0
-            block_norms(X, t0, p_s, nrm_b)
+            if has_ref:
+                for l in range(ng):
+                    gr[l] = g_ref[0, l]
+            block_norms(X, t0, p_s, gr, nrm_b, dn_b)
             for j in range(cnt):
                 for l in range(N2):
                     xs_h[l] = X[l, j]
                 e0[lo + j] = energy(t0, xs_h, p, ws_h)
                 nrm = nrm_b[j]
-                out_norm[lo + j, 0] = nrm
+                if trace_row[lo + j] >= 0:
+                    out_norm[trace_row[lo + j], 0] = nrm
+                begin(lt, lv, base, meas, j, lo + j, nrm, dn_b[j])
                 active[j] = True
                 alive += 1
                 if not (nrm <= threshold):
@@ -326,6 +360,9 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 if alive == 0:
                     break
                 t = t0 + (i - 1) * tau
+                if has_ref:
+                    for l in range(ng):
+                        gr[l] = g_ref[i - 1, l]
                 for j in range(B):  # the whole step of every member
                     ws = stack_workspace()
                     xk = stack1(N2)
@@ -333,10 +370,20 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     xn = stack1(N2)
                     for l in range(N2):
                         xk[l] = X[l, j]
-                    c = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn)
+                    c, gn, dn = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn, gr)
                     for l in range(N2):
                         X[l, j] = xn[l]
                     code[j] |= c
+                    gn_b[j] = gn
+                    dn_b[j] = dn
+                # ‖g‖ at step i − 1 on each running member's ladder (a scatter: apart from
+                # the vectorized loop above); steps done again after a rollback put the
+                # same numbers again
+                window = min(4, (5 * (i - 1)) // nsteps)
+                for j in range(cnt):
+                    if active[j]:
+                        observe(lt, lv, base, meas, j, lo + j, (i - 1) * tau, gn_b[j],
+                                dn_b[j], window)  # fmt: skip
                 until_save -= 1
                 renew = True
                 if i <= careful_to:  # stop the members whose step failed; Xc: the step before
@@ -357,11 +404,12 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     renew = False
                 if until_save == 0:  # a stored sample, of the members whose steps succeeded
                     until_save = save_every
-                    block_norms(X, t0 + i * tau, p_s, nrm_b)
+                    block_norms(X, t0 + i * tau, p_s, gr, nrm_b, dn_b)
                     for j in range(cnt):
                         if active[j]:
                             nrm = nrm_b[j]
-                            out_norm[lo + j, i // save_every] = nrm
+                            if trace_row[lo + j] >= 0:
+                                out_norm[trace_row[lo + j], i // save_every] = nrm
                             if not (nrm <= threshold):
                                 status[lo + j] = _DIVERGED
                                 fail_step[lo + j] = i
@@ -377,13 +425,24 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                             Xc[l, j] = X[l, j]
                 i += 1
             tf = t0 + nsteps * tau
+            if has_ref:
+                for l in range(ng):
+                    gr[l] = g_ref[nsteps, l]
+            block_norms(X, tf, p_s, gr, nrm_b, dn_b)
             for j in range(cnt):
+                final = math.nan
                 if active[j]:
                     for l in range(N2):
                         x_final[lo + j, l] = X[l, j]
+                    final = nrm_b[j]
+                    observe(lt, lv, base, meas, j, lo + j, nsteps * tau, final, dn_b[j], 4)
                 for l in range(N2):
                     xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
+                finish(lt, lv, meas, j, lo + j, final, not active[j], tau, rt, ry, fa, fb, lg)
+                if R.shape[0] > 0:
+                    predict(R, alpha0s[lo + j], nsteps, tau, lt, lv, base, meas, j, lo + j,
+                            rt, ry, fa, fb, lg, g_p, gn_p)  # fmt: skip
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
     tag(key, block_norms, retire, stop_failed, block_failed, member_step)

@@ -51,14 +51,19 @@ def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) ->
 
 
 def summary(ds: xr.Dataset) -> str:
-    """Per grid point: fraction bounded, δ*, median β beside the predictions."""
-    cols = [c for c in ("fraction_bounded", "stability_radius", "beta_median",
+    """Per grid point: fractions stable and bounded, δ*, median β (with the members that
+    have one) beside the predictions."""
+    cols = [c for c in ("fraction_stable", "fraction_bounded", "stability_radius",
+                        "beta_median", "members_with_beta", "beta_ratio_median",
                         "beta_theory_discrete", "spectral_radius", "norm_condition",
                         "beta_theorem5_proven", "beta_theorem5_printed") if c in ds]  # fmt: skip
-    short = {"fraction_bounded": "bounded", "stability_radius": "delta*", "beta_median":
-             "beta_med", "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
+    short = {"fraction_stable": "stable", "fraction_bounded": "bounded",
+             "stability_radius": "delta*", "beta_median": "beta_med",
+             "members_with_beta": "n_beta", "beta_ratio_median": "meas/lin",
+             "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
              "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
              "beta_theorem5_printed": "b5_printed"}  # fmt: skip
-    head = ("summary (bounded: fraction of members; delta*: stability radius; "
-            "beta_pred = -ln rho(R)/tau):")  # fmt: skip
+    head = ("summary (stable, bounded: fractions of members; delta*: stability radius; "
+            "n_beta: members with a measured beta; meas/lin: median of measured over the "
+            "linear prediction's beta; beta_pred = -ln rho(R)/tau):")  # fmt: skip
     return "\n" + head + "\n" + grid_table(ds, cols, short, flags=("norm_condition",)) + "\n"

@@ -70,11 +70,11 @@ def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dat
         t0 = float(ds.time[0])
         nsave = (ds.sizes["time"] - 1) * stride + 1
         times = t0 + (np.arange(nsave) / stride) * float(ds.time[1] - ds.time[0])
-        full = np.full((ds.sizes["member"], nsave), np.nan, dtype=ds.residual_norm.dtype)
+        full = np.full((ds.sizes["trace"], nsave), np.nan, dtype=ds.residual_norm.dtype)
         full[:, ::stride] = ds.residual_norm.values
         attrs = ds.residual_norm.attrs
         ds = ds.drop_vars("residual_norm").assign_coords(time=("time", times, ds.time.attrs))
-        ds["residual_norm"] = (("member", "time"), full, attrs)
+        ds["residual_norm"] = (("trace", "time"), full, attrs)
     for key in _VOLATILE:
         ds.attrs.pop(key, None)
     return ds

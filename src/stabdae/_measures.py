@@ -1,0 +1,138 @@
+"""What an ensemble reports: each member's class with its reason, and the summaries with
+their uncertainty.
+
+Per member (from the measures of :mod:`.kernels.decay`: its initial norm, the largest norm
+over each fifth of the run ``W0 … W4``, the floor ``W4``) a *stability class*:
+
+``decayed``
+    fell below where it started and stayed within ε;
+``overshoot``
+    as ``decayed``, but above ε on the way: the law's own transient (a critically damped
+    law's ``‖e^{Ãt}‖∞`` peaks near ``ω/e``); ``overshoot`` (largest / initial norm) is
+    stored beside the law's ``sup_k ‖R(τÃ)^k‖∞``;
+``at floor``
+    started within reach of the scheme's floor and stayed there, within ε;
+``floor above epsilon``
+    not growing, but the floor itself (the scheme's local error at this step) lies above
+    ε: a property of the step size, not an instability;
+``growing``
+    the largest norm of each of the last three fifths grows, and the last is at least
+    ``GROWTH`` times the third: unstable over this run, though not yet diverged;
+``diverged``
+    stopped by the divergence threshold, a non-finite state or a singular ``S``;
+``not run``
+    not placed, or an adaptive member that ran out of steps.
+
+*Stable* is one of the first four; *bounded* (Definition 2 of the paper) is stable with
+the largest norm within ε.  The fractions come with Wilson 95 % intervals, the median
+decay rate with an order-statistics interval, and every summary with the counts behind it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._status import Status
+from .kernels import decay
+
+#: class codes of ``stability_class``
+DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON, GROWING, DIVERGED, NOT_RUN = range(7)
+CLASSES = ("decayed", "overshoot", "at_floor", "floor_above_epsilon", "growing", "diverged",
+           "not_run")  # fmt: skip
+STABLE = (DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON)
+#: growth of the largest norm from the third fifth of the run to the last that marks a
+#: member growing (the three last fifths increasing as well)
+GROWTH = 1.5
+#: the normal quantile of the 95 % intervals
+Z95 = 1.959963984540054
+
+_BLOWN_UP = (Status.DIVERGED, Status.NONFINITE_STATE, Status.SINGULAR_S, Status.MASS_NOT_SPD)
+
+
+def classify(meas: np.ndarray, status: np.ndarray, epsilon: float) -> np.ndarray:
+    """The stability class of each member (int8, codes of :data:`CLASSES`)."""
+    initial, largest = meas[:, decay.C_INITIAL], meas[:, decay.C_LARGEST]
+    w2, w3, w4 = meas[:, decay.C_W2], meas[:, decay.C_W3], meas[:, decay.C_W4]
+    with np.errstate(invalid="ignore"):
+        growing = (w4 > GROWTH * w2) & (w4 >= w3) & (w3 >= w2)
+        fell = w4 < initial
+        within = largest <= epsilon
+        floor_ok = w4 <= epsilon
+    cls = np.full(status.shape, AT_FLOOR, dtype=np.int8)
+    cls[~floor_ok] = FLOOR_ABOVE_EPSILON
+    cls[fell & floor_ok & within] = DECAYED
+    cls[fell & floor_ok & ~within] = OVERSHOOT
+    cls[growing] = GROWING
+    blown = np.isin(status, [int(s) for s in _BLOWN_UP])
+    cls[blown] = DIVERGED
+    cls[(status != 0) & ~blown] = NOT_RUN
+    return cls
+
+
+def wilson(successes: int, n: int) -> tuple[float, float]:
+    """Wilson's 95 % score interval of a fraction (NaN for ``n = 0``)."""
+    if n == 0:
+        return math.nan, math.nan
+    p = successes / n
+    z2 = Z95 * Z95
+    centre = (p + z2 / (2 * n)) / (1 + z2 / n)
+    half = Z95 * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / (1 + z2 / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def median_interval(values) -> tuple[float, float, float]:
+    """The median of the finite values with a distribution-free 95 % interval from order
+    statistics (ranks ``n/2 ∓ 1.96 √n / 2``); NaN where there are too few values."""
+    v = np.sort(np.asarray(values, dtype=float)[np.isfinite(values)])
+    n = v.size
+    if n == 0:
+        return math.nan, math.nan, math.nan
+    med = float(np.median(v))
+    half = Z95 * math.sqrt(n) / 2.0
+    lo, hi = int(math.floor(n / 2.0 - half)), int(math.ceil(n / 2.0 + half))
+    if lo < 0 or hi > n - 1:
+        return med, math.nan, math.nan
+    return med, float(v[lo]), float(v[hi])
+
+
+def stability_radius(alpha_norm, stable, ran) -> tuple[float, float, float, str]:
+    """δ* with its bracket: ``(δ*, low, high, reason)``.  ``high`` is the smallest
+    ``‖α⁰‖`` of a member that was not stable, ``low`` the largest below it (every member
+    up to ``low`` was stable); δ* is their geometric mean, NaN with a reason when the
+    sample does not bracket it."""
+    a, ok = np.asarray(alpha_norm)[ran], np.asarray(stable)[ran]
+    if a.size == 0:
+        return math.nan, math.nan, math.nan, "no member ran"
+    if ok.all():
+        return math.nan, float(a.max()), math.nan, "every member stable: delta* is above the sample"
+    high = float(a[~ok].min())
+    below = a[a < high]
+    if below.size == 0:
+        return math.nan, math.nan, high, "no member stable below the smallest failure"
+    low = float(below.max())
+    return math.sqrt(low * high), low, high, "bracketed"
+
+
+def summaries(meas, cls, status, alpha_norm, epsilon) -> dict:
+    """The ensemble's scalar summaries with their intervals and counts."""
+    ran = cls != NOT_RUN
+    stable = np.isin(cls, STABLE)
+    with np.errstate(invalid="ignore"):
+        bounded = stable & (meas[:, decay.C_LARGEST] <= epsilon)
+    n = int(ran.sum())
+    beta = meas[:, decay.C_BETA]
+    out = {"members_run": n, "members_stable": int((stable & ran).sum()),
+           "members_bounded": int((bounded & ran).sum()),
+           "members_diverged": int((cls == DIVERGED).sum()),
+           "members_growing": int((cls == GROWING).sum()),
+           "members_with_beta": int(np.isfinite(beta).sum())}  # fmt: skip
+    for name, k in (("fraction_stable", out["members_stable"]),
+                    ("fraction_bounded", out["members_bounded"])):  # fmt: skip
+        out[name] = k / n if n else math.nan
+        out[name + "_low"], out[name + "_high"] = wilson(k, n)
+    out["beta_median"], out["beta_median_low"], out["beta_median_high"] = median_interval(beta)
+    delta, low, high, why = stability_radius(alpha_norm, stable, ran)
+    out.update(stability_radius=delta, stability_radius_low=low, stability_radius_high=high)
+    return out, why
