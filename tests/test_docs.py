@@ -66,11 +66,11 @@ def test_xarray_recipe_runs(tmp_path, monkeypatch):
     assert namespace["ratio"].dims == ("tau", "omega")
     ds = namespace["ds"]
     # what the recipe says it computes, cell by cell from the raw arrays
-    fb, rho = ds.fraction_bounded.values, ds.spectral_radius.values
+    fb, rho = ds.fraction_stable.values, ds.spectral_radius.values
     cells = [(fb[i, j] == 1) == (rho[i, j] < 1) for i in range(fb.shape[0])
              for j in range(fb.shape[1])]  # fmt: skip
     assert float(namespace["agree"]) == sum(cells) / len(cells)
-    kept = (ds.fraction_bounded > 0).values
+    kept = (ds.fraction_stable > 0).values
     assert kept.any() and np.all(np.isfinite(namespace["worst"].values[kept]))
     ds.close()
 
