@@ -329,7 +329,7 @@ def test_generated_member_step_is_visible_and_can_be_dumped(tmp_path, monkeypatc
     assert source in dumped
     from stabdae.kernels.ensemble import _member_step
 
-    step = _member_step(lambda *a: 0, 4, tableau_pattern(scheme))
+    step = _member_step(lambda *a: 0, 4, 2, tableau_pattern(scheme))
     assert inspect.getsource(step.py_func) == source
     assert inspect.getsourcefile(step.py_func).startswith("<stabdae generated member_step")
 
