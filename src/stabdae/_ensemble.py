@@ -467,10 +467,9 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
     meas[(status != 0) & (meas[:, C.C_REASON] == C.R_FITTED), C.C_REASON] = C.R_STOPPED
     cls = _measures.classify(meas, status, epsilon)
     alpha_norm = np.max(np.abs(alpha0), axis=1)
-    summary, radius_why = _measures.summaries(meas, cls, status, alpha_norm, epsilon)
-    stable = np.isin(cls, _measures.STABLE)
+    summary, radius_why = _measures.summaries(meas, cls, alpha_norm, epsilon)
+    stable, bounded = _measures.flags(meas, cls, epsilon)
     with np.errstate(invalid="ignore", divide="ignore"):
-        bounded = stable & (meas[:, C.C_LARGEST] <= epsilon)
         overshoot = meas[:, C.C_LARGEST] / meas[:, C.C_INITIAL]
     diverged = cls == _measures.DIVERGED
 
@@ -512,7 +511,9 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
             values["beta_ratio"] = meas[:, C.C_BETA] / beta_pred
         med = _measures.median_interval(values["beta_ratio"])
         values["beta_ratio_median"] = med[0]
-        values["overshoot_theory"] = theory.transient_peak(R)
+        # the law's transient within this run (R over the run's steps, or the prediction's)
+        steps = run["steps"] if "steps" in run else PREDICTION_STEPS
+        values["overshoot_theory"] = theory.transient_peak(R, max_steps=steps)
     if model.energy is not None:
         values["energy_drift"] = e1 - e0
     values.update(extra or {})

@@ -17,7 +17,7 @@ over each fifth of the run ``W0 … W4``, the floor ``W4``) a *stability class*:
     ε: a property of the step size, not an instability;
 ``growing``
     the largest norm of each of the last three fifths grows, and the last is at least
-    ``GROWTH`` times the third: unstable over this run, though not yet diverged;
+    ``decay.GROWTH`` times the third: unstable over this run, though not yet diverged;
 ``diverged``
     stopped by the divergence threshold, a non-finite state or a singular ``S``;
 ``not run``
@@ -42,9 +42,6 @@ DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON, GROWING, DIVERGED, NOT_RUN = 
 CLASSES = ("decayed", "overshoot", "at_floor", "floor_above_epsilon", "growing", "diverged",
            "not_run")  # fmt: skip
 STABLE = (DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON)
-#: growth of the largest norm from the third fifth of the run to the last that marks a
-#: member growing (the three last fifths increasing as well)
-GROWTH = 1.5
 #: the normal quantile of the 95 % intervals
 Z95 = 1.959963984540054
 
@@ -55,8 +52,8 @@ def classify(meas: np.ndarray, status: np.ndarray, epsilon: float) -> np.ndarray
     """The stability class of each member (int8, codes of :data:`CLASSES`)."""
     initial, largest = meas[:, decay.C_INITIAL], meas[:, decay.C_LARGEST]
     w2, w3, w4 = meas[:, decay.C_W2], meas[:, decay.C_W3], meas[:, decay.C_W4]
+    growing = decay.grows(w2, w3, w4)
     with np.errstate(invalid="ignore"):
-        growing = (w4 > GROWTH * w2) & (w4 >= w3) & (w3 >= w2)
         fell = w4 < initial
         within = largest <= epsilon
         floor_ok = w4 <= epsilon
@@ -115,12 +112,18 @@ def stability_radius(alpha_norm, stable, ran) -> tuple[float, float, float, str]
     return math.sqrt(low * high), low, high, "bracketed"
 
 
-def summaries(meas, cls, status, alpha_norm, epsilon) -> dict:
-    """The ensemble's scalar summaries with their intervals and counts."""
-    ran = cls != NOT_RUN
+def flags(meas, cls, epsilon):
+    """Per member: ``(stable, bounded)``, bounded being stable and within ε at every step
+    (Definition 2)."""
     stable = np.isin(cls, STABLE)
     with np.errstate(invalid="ignore"):
-        bounded = stable & (meas[:, decay.C_LARGEST] <= epsilon)
+        return stable, stable & (meas[:, decay.C_LARGEST] <= epsilon)
+
+
+def summaries(meas, cls, alpha_norm, epsilon) -> dict:
+    """The ensemble's scalar summaries with their intervals and counts."""
+    ran = cls != NOT_RUN
+    stable, bounded = flags(meas, cls, epsilon)
     n = int(ran.sum())
     beta = meas[:, decay.C_BETA]
     out = {"members_run": n, "members_stable": int((stable & ran).sum()),

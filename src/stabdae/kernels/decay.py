@@ -74,6 +74,9 @@ MIN_POINTS = 12
 MIN_DECADES = 1.0
 #: a fit whose RMS deviation in log ‖g‖ exceeds this is not of a smooth decay
 SMOOTH_RMS = 0.01
+#: growth of the largest norm from the third fifth of the run to the last that, with the
+#: last three fifths increasing, marks a member growing (:func:`grows`)
+GROWTH = 1.5
 #: the run ended inside the transient: each of the last three fifths fell by this factor
 STILL_DECAYING = 3.0
 N_SHIFTS = 16
@@ -194,18 +197,27 @@ def _solve3(a, b):
 
 
 @njit(cache=True)
-def _fit_linear(rt, ry, start, end):
-    """Least squares ``y ≈ c − β t`` on points [start, end); returns (β, SSE)."""
+def _centered_sums(rt, ry, start, end):
+    """Means of ``t`` and ``y`` on [start, end) and the centred sums ``Σ(t − t̄)²``,
+    ``Σ(t − t̄)(y − ȳ)``, ``Σ(y − ȳ)²`` of both regressions."""
     cnt = end - start
     st = sy = 0.0
     for i in range(start, end):
         st += rt[i]
         sy += ry[i]
     tm, ym = st / cnt, sy / cnt
-    stt = sty = 0.0
+    stt = sty = syy = 0.0
     for i in range(start, end):
         stt += (rt[i] - tm) ** 2
         sty += (rt[i] - tm) * (ry[i] - ym)
+        syy += (ry[i] - ym) ** 2
+    return tm, ym, stt, sty, syy
+
+
+@njit(cache=True)
+def _fit_linear(rt, ry, start, end):
+    """Least squares ``y ≈ c − β t`` on points [start, end); returns (β, SSE)."""
+    tm, ym, stt, sty, _ = _centered_sums(rt, ry, start, end)
     if stt == 0.0:
         return math.nan, math.inf
     slope = sty / stt
@@ -219,16 +231,7 @@ def _fit_linear(rt, ry, start, end):
 @njit(cache=True)
 def _fit_inverse(rt, ry, start, end):
     """Least squares ``t ≈ a + b y`` on [start, end); returns ``β = −1/b``."""
-    cnt = end - start
-    st = sy = 0.0
-    for i in range(start, end):
-        st += rt[i]
-        sy += ry[i]
-    tm, ym = st / cnt, sy / cnt
-    syy = sty = 0.0
-    for i in range(start, end):
-        syy += (ry[i] - ym) ** 2
-        sty += (rt[i] - tm) * (ry[i] - ym)
+    _, _, _, sty, syy = _centered_sums(rt, ry, start, end)
     if sty == 0.0:
         return math.nan
     return -syy / sty
@@ -404,10 +407,9 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out):
         return
     start, end = _window(rt, ry, n, floor, still_decaying)
     if end == 0:
-        # no decade of decay above the floor: growing (the largest norm of each of the
-        # last three fifths larger, doubling from the third), or started near its floor
-        growing = (out[C_D4] > 2.0 * out[C_D2] and out[C_D4] >= out[C_D3] >= out[C_D2])
-        out[C_REASON] = R_NOT_DECAYING if growing else R_NO_TRANSIENT
+        # no decade of decay above the floor: growing, or started near its floor
+        out[C_REASON] = (R_NOT_DECAYING if grows(out[C_D2], out[C_D3], out[C_D4])
+                         else R_NO_TRANSIENT)  # fmt: skip
         return
     beta, sse = _fit_linear(rt, ry, start, end)
     kind = K_EXPONENTIAL
@@ -455,6 +457,13 @@ def refit(rt, ry, n, t_lo, t_hi, kind, dt, a, b, lg):
     if kind == K_OSCILLATING:
         return _fit_inverse(rt, ry, start, end)
     return math.nan
+
+
+@njit(cache=True)
+def grows(w2, w3, w4):
+    """Whether the largest norms of the last three fifths of a run (scalars or arrays)
+    increase, by ``GROWTH`` from the third fifth to the fifth: a growing member."""
+    return (w4 > GROWTH * w2) & (w4 >= w3) & (w3 >= w2)
 
 
 # --------------------------------------------------------------------- per member
