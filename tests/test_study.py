@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import stabdae
 from stabdae.study.cli import main
@@ -256,3 +257,69 @@ def test_shipped_studies_load_from_the_repository_root(name, monkeypatch):
     monkeypatch.chdir(root)
     study = load_study(root / "studies" / name)
     assert study.output == root / "results" / name.replace(".toml", ".nc")
+
+
+SEARCH = """
+[model]
+file = "pendulum"
+
+[law]
+kind = "baumgarte"
+omega = 10.0
+xi = 1.0
+
+[scheme]
+name = "rk4"
+
+[run]
+epsilon = 1.0
+
+[ensemble]
+members = 16
+radius = [1e-8, 1e-3]
+seed = 1
+
+[search]
+tau = { bisect = [1e-3, 3.0], rtol = 0.05 }
+search_members = 8
+steps = 2000
+
+[sweep]
+omega = [10.0, 100.0]
+"""
+
+
+def test_search_study_finds_the_boundary_per_point_and_plots_it(tmp_path):
+    """A [search] study: one boundary per value of the other axes, equal to
+    stabdae.boundary at that point; the summary and picture follow."""
+    from stabdae.plots import plot_dataset
+    from stabdae.study.run import run_study
+
+    path = write(tmp_path, SEARCH)
+    study = load_study(path)
+    assert study.search["tau"] == (1e-3, 3.0) and "searched: tau" in study.describe()
+    lines = []
+    out = run_study(study, tmp_path / "b.nc", progress=False, log=lines.append)
+    ds = xr.open_dataset(out).load()
+    assert ds.tau_star.dims == ("omega",) and ds.probe_tau.dims == ("omega", "probe")
+    one = stabdae.boundary(study.model, stabdae.baumgarte(100.0, 1.0), "rk4",
+                           tau=(1e-3, 3.0), rtol=0.05, members=16, search_members=8,
+                           steps=2000, radius=(1e-8, 1e-3), seed=1, epsilon=1.0)  # fmt: skip
+    assert float(ds.tau_star.sel(omega=100.0)) == float(one.tau_star)
+    assert (ds.tau_star < ds.tau_limit_spectral).all()
+    assert "tau_spectral" in lines[-2]
+    pictures = plot_dataset(out, tmp_path / "pic")
+    assert [p.name for p in pictures] == ["pic_boundary.png"] and pictures[0].stat().st_size
+
+
+@pytest.mark.parametrize("edit, message", [
+    (("steps = 2000", "steps = 2000\nt_end = 2.0"), r"\[search\] t_end: give steps or t_end"),
+    (("bisect = [1e-3, 3.0]", "bisect = [3.0, 1e-3]"), r"\[search\] tau.bisect: needs 0 < low"),
+    (("rtol = 0.05", "rtol = 5.0"), r"\[search\] tau.rtol: must lie in"),
+    (("omega = [10.0, 100.0]", "tau = [0.1, 0.2]"), r"\[sweep\] tau: is searched"),
+    (("search_members = 8", "search_members = 8\nq = 1.0"), r"\[search\] q:"),
+])  # fmt: skip
+def test_search_validation(tmp_path, edit, message):
+    path = write(tmp_path, SEARCH.replace(*edit))
+    with pytest.raises(StudyError, match=r"^study.toml: " + message):
+        load_study(path)

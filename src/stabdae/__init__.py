@@ -9,6 +9,7 @@ below it: :mod:`stabdae.kernels` (compiled), the drivers and definitions here,
 
 from . import theory
 from ._adaptive import integrate_adaptive
+from ._boundary import boundary
 from ._ensemble import ensemble, sample_perturbations
 from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, acpr, baumgarte, matrix, none, theorem5, user
@@ -41,6 +42,7 @@ __all__ = [
     "__version__",
     "acpr",
     "baumgarte",
+    "boundary",
     "dopri5",
     "ensemble",
     "euler",

@@ -11,6 +11,7 @@ predictions (:mod:`.theory`).
 
 from __future__ import annotations
 
+import math
 import time
 import warnings
 from collections import Counter
@@ -311,6 +312,8 @@ def ensemble(
                 epsilon=epsilon, divergence=divergence, sampling_rtol=SAMPLING_RTOL,
                 threads=threads if threads is not None else default_threads()),
         extra=out.get("extra"),
+        roundoff=_roundoff(model, out["x_final"], status, p, float(out["times"][-1]), R,
+                           nsteps if not adaptive else PREDICTION_STEPS, threads),
     )  # fmt: skip
     # wall times (compilation included on a first call) for benchmarks; not part of the data
     ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
@@ -457,19 +460,40 @@ def _warn_stopped(model, status) -> None:
     )
 
 
+#: members whose final states set the roundoff level the growth test compares with
+ROUNDOFF_SAMPLE = 16
+
+
+def _roundoff(model, x_final, status, p, t, R, steps, threads):
+    """What roundoff can build up in the residual by the end of the run: its level at the
+    final states of up to ``ROUNDOFF_SAMPLE`` members that ran to the end, evenly spaced
+    (:func:`._measures.roundoff_level`), accumulated by the law's recursion
+    (:func:`.theory.forced_gain`; once where it is unknown or unbounded)."""
+    ran = np.flatnonzero(status == 0)
+    if ran.size == 0:
+        return 0.0
+    pick = ran[np.unique(np.linspace(0, ran.size - 1, min(ROUNDOFF_SAMPLE, ran.size))
+                         .astype(int))]  # fmt: skip
+    level = _measures.roundoff_level(
+        lambda X, at: _residual_rows(model, np.ascontiguousarray(X), p, at, threads),
+        x_final[pick], t)  # fmt: skip
+    gain = theory.forced_gain(R, max_steps=steps) if R.shape[0] > 0 else math.inf
+    return level * (gain if math.isfinite(gain) else 1.0)
+
+
 def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
                       x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
-                      extra=None):  # fmt: skip
+                      extra=None, roundoff=0.0):  # fmt: skip
     C = decay
     meas[status != 0, C.C_BETA_PRED] = np.nan  # (not placed: measured on nothing)
     for c in (C.C_BETA, C.C_GAMMA):
         meas[status != 0, c] = np.nan
     meas[(status != 0) & (meas[:, C.C_REASON] == C.R_FITTED), C.C_REASON] = C.R_STOPPED
-    cls = _measures.classify(meas, status, epsilon)
+    cls = _measures.classify(meas, status, epsilon, roundoff)
     alpha_norm = np.max(np.abs(alpha0), axis=1)
     summary, radius_why = _measures.summaries(meas, cls, alpha_norm, epsilon)
     stable, bounded = _measures.flags(meas, cls, epsilon)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         overshoot = meas[:, C.C_LARGEST] / meas[:, C.C_INITIAL]
     diverged = cls == _measures.DIVERGED
 

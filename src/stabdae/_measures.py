@@ -17,7 +17,8 @@ over each fifth of the run ``W0 … W4``, the floor ``W4``) a *stability class*:
     ε: a property of the step size, not an instability;
 ``growing``
     the largest norm of each of the last three fifths grows, and the last is at least
-    ``decay.GROWTH`` times the third: unstable over this run, though not yet diverged;
+    ``decay.GROWTH`` times the third, above what roundoff can build up: unstable over this
+    run, though not yet diverged;
 ``diverged``
     stopped by the divergence threshold, a non-finite state or a singular ``S``;
 ``not run``
@@ -45,15 +46,38 @@ STABLE = (DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON)
 #: the normal quantile of the 95 % intervals
 Z95 = 1.959963984540054
 
+#: codes of a boundary search's ``tau_star_reason``
+BRACKETED, LOW_END_FAILS, HIGH_END_STABLE, CONFIRM_FAILS = range(4)
+TAU_STAR_REASONS = {
+    BRACKETED: "bracketed", LOW_END_FAILS: "not stable at the bracket's low end",
+    HIGH_END_STABLE: "stable at the bracket's high end",
+    CONFIRM_FAILS: "the full ensemble is not stable above the bracket's low end",
+}  # fmt: skip
+#: a boundary search's probe stages (``probe_stage``)
+ENDS, GUIDED, BISECTION, CONFIRM = range(4)
+STAGES = {ENDS: "bracket ends", GUIDED: "beside the spectral limit", BISECTION: "bisection",
+          CONFIRM: "full ensemble"}  # fmt: skip
+
+#: how far above the roundoff it can build up a rising residual must be to be growth
+ROUNDOFF_MARGIN = 10.0
+
 _BLOWN_UP = (Status.DIVERGED, Status.NONFINITE_STATE, Status.SINGULAR_S, Status.MASS_NOT_SPD)
 
 
-def classify(meas: np.ndarray, status: np.ndarray, epsilon: float) -> np.ndarray:
-    """The stability class of each member (int8, codes of :data:`CLASSES`)."""
+def classify(meas: np.ndarray, status: np.ndarray, epsilon: float,
+             roundoff: float = 0.0) -> np.ndarray:  # fmt: skip
+    """The stability class of each member (int8, codes of :data:`CLASSES`).
+
+    ``roundoff``: the size of the residual that roundoff alone can build up by the end of
+    the run (:func:`roundoff_level` at the final states, times the law's
+    :func:`stabdae.theory.forced_gain` where it is known).  A member grows only where its
+    last fifth rises above ``ROUNDOFF_MARGIN`` times that: below it, a residual that
+    rises is roundoff growing with the size of the state (a model whose coordinates
+    drift), not an instability."""
     initial, largest = meas[:, decay.C_INITIAL], meas[:, decay.C_LARGEST]
     w2, w3, w4 = meas[:, decay.C_W2], meas[:, decay.C_W3], meas[:, decay.C_W4]
-    growing = decay.grows(w2, w3, w4)
     with np.errstate(invalid="ignore"):
+        growing = decay.grows(w2, w3, w4) & (w4 > ROUNDOFF_MARGIN * roundoff)
         fell = w4 < initial
         within = largest <= epsilon
         floor_ok = w4 <= epsilon
@@ -66,6 +90,34 @@ def classify(meas: np.ndarray, status: np.ndarray, epsilon: float) -> np.ndarray
     cls[blown] = DIVERGED
     cls[(status != 0) & ~blown] = NOT_RUN
     return cls
+
+
+def roundoff_level(residual_rows, states, t: float) -> float:
+    """The size roundoff gives the residual at these states: the median over the states of
+    ``u · max_c (Σ_i |∂g_c/∂x_i · x_i| + |∂g_c/∂t · t|)`` (``u`` the unit roundoff), each
+    term the change of ``g`` when one entry of the state (or the time) moves by one
+    rounding, by central differences.  ``residual_rows(X, t)`` evaluates ``g`` at every row
+    of ``X``."""
+    states = np.asarray(states, dtype=float)
+    if states.size == 0:
+        return 0.0
+    h = 1e-6
+    u = np.finfo(float).eps / 2.0
+    levels = []
+    for x in states:
+        n2 = x.size
+        X = np.repeat(x[None, :], 2 * n2 + 1, axis=0)
+        idx = np.arange(n2)
+        X[2 * idx, idx] += h * x
+        X[2 * idx + 1, idx] -= h * x
+        G = residual_rows(X, t)
+        terms = np.abs(G[0:-1:2] - G[1:-1:2]).sum(axis=0) / (2.0 * h)
+        if t != 0.0:
+            Gt = residual_rows(X[-1:].repeat(2, axis=0), t * (1.0 + h))[0]
+            terms = terms + np.abs(Gt - G[-1]) / h
+        if np.all(np.isfinite(terms)):
+            levels.append(float(terms.max()) if terms.size else 0.0)
+    return u * float(np.median(levels)) if levels else 0.0
 
 
 def wilson(successes: int, n: int) -> tuple[float, float]:

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ._measures import CLASSES
+from ._measures import CLASSES, STAGES, TAU_STAR_REASONS
 from ._status import Status, status_flag_attrs
 from ._version import __version__
 from .kernels.decay import KINDS, REASONS
@@ -144,6 +144,20 @@ SCHEMA: dict[str, tuple] = {
     "tau_limit_max_norm": ((), "largest tau with max-norm of R < 1", "s", {}),
     "tau_limit_two_norm": ((), "largest tau with 2-norm of R < 1", "s", {}),
     "tau_limit_weighted_norm": ((), "largest tau with the weighted norm of R < 1", "s", {}),
+    # --- a boundary search (stabdae.boundary; per grid point of a [search] study)
+    "tau_star": ((), "largest stable step size: the geometric mean of its bracket", "s", {}),
+    "tau_star_low": ((), "tau_star bracket, low: stable with the full ensemble", "s", {}),
+    "tau_star_high": ((), "tau_star bracket, high: not stable", "s", {}),
+    "tau_star_reason": ((), "why tau_star is or is not bracketed", "1",
+                        _flags(TAU_STAR_REASONS)),
+    "tau_limit_floor": ((), "largest tau at which Theorems 6/7 with condition 4 bound the "
+                        "residual by epsilon (the floor the local error forces)", "s", {}),
+    "probe_tau": ("probe", "step size of the probe", "s", {}),
+    "probe_members": ("probe", "members of the probe's ensemble", "1", {}),
+    "probe_fraction_stable": ("probe", "fraction of stable members at the probe", "1", {}),
+    "probe_stable": ("probe", "the probe counted as stable (fraction at least 1 - q)", "1",
+                     _FLAG),
+    "probe_stage": ("probe", "stage of the search", "1", _flags(STAGES)),
     "lambda_min_W": ((), "min eigenvalue of W = h_v h_v^T over x0 and x_final", "1", {}),
     "beta_theorem5_proven": ((), "Theorem 5 rate k0 lambda_min(W) l1^2/lm (proven)", "s-1",
                              {}),
@@ -204,6 +218,12 @@ _GROUPS = (
         "tau_limit_weighted_norm", "theorem5_lambda_min_W", "theorem5_beta_proven",
         "theorem5_beta_printed", "theorem5_gamma_factor", "path_spectral_radius_max",
         "path_norm_weighted_max", "path_epsilon")),
+    ("A boundary search: `boundary` (and per grid point, `stabdae run` with `[search]`)", (
+        "tau_star", "tau_star_low", "tau_star_high", "tau_star_reason", "fraction_stable",
+        "fraction_stable_low", "fraction_stable_high", "members_run", "members_stable",
+        "members_diverged", "members_growing", "tau_limit_spectral", "tau_limit_weighted_norm",
+        "tau_limit_floor", "spectral_radius", "probe_tau", "probe_members",
+        "probe_fraction_stable", "probe_stable", "probe_stage")),
     ("Theorems 6/7 along a trajectory: `theory.along_path` (the variables drop the `path_` "
      "prefix)", ("path_spectral_radius", "path_norm_max", "path_norm_2", "path_norm_weighted",
                  "path_remainder", "path_residual_norm", "path_q", "path_bound_start")),

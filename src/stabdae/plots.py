@@ -6,6 +6,10 @@
 * ``<stem>_decay.png`` — residual decay of sampled members at one grid point, each with
   its fitted ``γ e^{−βt}`` and the theory's rate.
 * ``<stem>_beta.png`` — median fitted ``β`` against the predicted one at every grid point.
+* ``<stem>_boundary.png`` — for a boundary search (``stabdae.boundary``, a study with
+  ``[search]``), instead of the three above: the measured ``τ*`` with its bracket over
+  the first swept axis, beside the theory's limits (``ρ(R(τÃ)) = 1``, and Theorems 6/7
+  with the floor the local error forces); with nothing swept, the probes.
 
 Needs matplotlib (``pip install 'stabdae[plots]'``).
 """
@@ -17,7 +21,9 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-__all__ = ["plot_dataset", "stability_map", "decay_curves", "beta_comparison"]
+__all__ = ["plot_dataset", "stability_map", "decay_curves", "beta_comparison",
+           "boundary_curve"]
+
 
 def _plt():
     import matplotlib
@@ -274,17 +280,82 @@ def plot_dataset(dataset, output=None) -> list[Path]:
         if not src.is_file():
             raise FileNotFoundError(f"stabdae plot: no such dataset: {src}")
         ds = xr.open_dataset(src).load()
-    if "fraction_bounded" not in ds:
-        raise ValueError("stabdae plot: the dataset has no fraction_bounded; it is not an "
-                         "ensemble or study dataset")  # fmt: skip
+    if "fraction_bounded" not in ds and "tau_star" not in ds:
+        raise ValueError("stabdae plot: the dataset has no fraction_bounded or tau_star; it "
+                         "is not an ensemble, boundary or study dataset")  # fmt: skip
     if output is None:
         stem = src.with_suffix("") if src is not None else Path("stabdae")
     else:
         out = Path(output)
         stem = out / (src.stem if src else "stabdae") if out.is_dir() else out.with_suffix("")
     stem.parent.mkdir(parents=True, exist_ok=True)
+    if "tau_star" in ds:
+        return [boundary_curve(ds, Path(f"{stem}_boundary.png"))]
     return [
         stability_map(ds, Path(f"{stem}_stability.png")),
         decay_curves(ds, Path(f"{stem}_decay.png")),
         beta_comparison(ds, Path(f"{stem}_beta.png")),
     ]
+
+
+def boundary_curve(ds: xr.Dataset, path: Path) -> Path:
+    """The measured stability boundary ``τ*`` with its bracket against the first swept
+    axis, over the theory's limits; with nothing swept, the probes of the search."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.2, 5.0), constrained_layout=True)
+    title = f"{ds.attrs.get('model', '')}: {ds.attrs.get('law', '')} law, " \
+            f"{ds.attrs.get('scheme', '')} — largest stable step τ*"  # fmt: skip
+    dims = list(ds["tau_star"].dims)
+    if dims:
+        sub, note = ds, ""
+        if len(dims) > 1:
+            sel = {d: 0 for d in dims[1:]}
+            sub = ds.isel(sel)
+            note = ", ".join(f"{d} = {float(ds[d][0]):g}" for d in sel)
+        x = sub[dims[0]].values
+        for var, style, label in (
+            ("tau_limit_spectral", dict(color="black", lw=2.0), "ρ(R(τÃ)) = 1 (spectral)"),
+            ("tau_limit_floor", dict(color="orangered", lw=1.5, ls="--"),
+             "Theorems 6/7 with the floor: ‖g‖ ≤ ε guaranteed below"),
+        ):  # fmt: skip
+            if var in sub and np.isfinite(sub[var].values).any():
+                ax.plot(x, sub[var].values, label=label, **style)
+        star = sub["tau_star"].values
+        lo, hi = sub["tau_star_low"].values, sub["tau_star_high"].values
+        ok = np.isfinite(star)
+        ax.errorbar(x[ok], star[ok], yerr=[star[ok] - lo[ok], hi[ok] - star[ok]], fmt="o",
+                    color="tab:blue", ms=5, capsize=3, label="measured τ* (bracket)")
+        for xi, l_, h_ in zip(x[~ok], lo[~ok], hi[~ok]):  # no bracket: the end that held
+            y = l_ if np.isfinite(l_) else h_
+            ax.plot([xi], [y], marker="^" if np.isfinite(l_) else "v", color="tab:red")
+        if (~ok).any():
+            ax.plot([], [], "^", color="tab:red", label="not bracketed (▲ stable up to, ▼ "
+                    "unstable from)")  # fmt: skip
+        ax.set_xlabel(_label(sub, dims[0]))
+        if _is_log(x) or (len(x) >= 2 and np.all(x > 0) and x.max() / x.min() >= 5):
+            ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_ylabel("step size τ [s]")
+        if note:
+            title += f"\n(at {note})"
+    else:
+        t = ds["probe_tau"].values
+        stable = ds["probe_stable"].values == 1
+        k = np.arange(t.size)
+        ax.plot(k, t, color="0.6", lw=0.8)
+        ax.plot(k[stable], t[stable], "o", color="tab:blue", label="stable")
+        ax.plot(k[~stable], t[~stable], "x", color="tab:red", label="not stable")
+        for var, style, label in (("tau_limit_spectral", dict(color="black"), "ρ = 1"),
+                                  ("tau_limit_floor", dict(color="orangered", ls="--"),
+                                   "Theorems 6/7 with the floor")):  # fmt: skip
+            v = float(ds[var])
+            if np.isfinite(v) and v > 0:
+                ax.axhline(v, label=label, **style)
+        ax.set_yscale("log")
+        ax.set_xlabel("probe")
+        ax.set_ylabel("step size τ [s]")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

@@ -55,10 +55,13 @@ __all__ = [
     "step_matrix",
     "spectral_radius",
     "spectral_radius_of",
+    "transient_peak",
+    "forced_gain",
     "eigenvalues",
     "weighted_norm",
     "discrete",
     "tau_limit",
+    "condition4",
     "theorem5",
     "along_path",
     "predictions",
@@ -171,6 +174,25 @@ def transient_peak(R, max_steps: int = 100_000) -> float:
         if nrm < 1e-6 * peak:
             break
     return peak
+
+
+def forced_gain(R, max_steps: int = 100_000) -> float:
+    """``Σ_k ‖R^k‖∞`` over ``k < max_steps``: how far errors of size 1 put in at every step
+    (roundoff, a local error) can accumulate in the residual recursion
+    ``g_{k+1} = R g_k + e_k``; ``inf`` when the powers grow past ``1e12`` (``ρ(R) ≥ 1``).
+    The sum stops when a term falls below a millionth of it."""
+    R = np.asarray(R, dtype=float)
+    P = np.eye(R.shape[0])
+    total = 0.0
+    for _ in range(max_steps):
+        nrm = float(np.abs(P).sum(axis=1).max())
+        if not nrm <= 1e12:
+            return math.inf
+        total += nrm
+        if nrm < 1e-6 * total:
+            break
+        P = R @ P
+    return total
 
 
 def eigenvalues(A_tilde) -> np.ndarray:
@@ -314,6 +336,31 @@ def tau_limit(A_tilde, scheme, condition: str = "spectral", *, tau_max: float | 
         else:
             bad = mid
     return good
+
+
+def condition4(R, residuals) -> dict:
+    """Theorems 6/7 with condition 4 for a constant step matrix ``R`` on a trajectory's
+    residuals ``g_k`` (rows, every step): ``q = ‖R‖_P`` in the discrete-Lyapunov weight
+    ``P`` of ``R``; the remainders ``e_k = g_{k+1} − R g_k`` the steps actually made; the
+    floor ``ε = ‖P⁻¹‖₂ max_k ‖P e_k‖₂ / (1 − q)`` and the bound's start
+    ``‖P⁻¹‖₂ ‖P g₀‖₂``, so that ``‖g_k‖∞ ≤ max(start, ε)``.  ``ε = inf`` when
+    ``ρ(R) ≥ 1`` (no weight with ``q < 1``)."""
+    R = np.asarray(R, dtype=float)
+    g = np.asarray(residuals, dtype=float)
+    if g.ndim != 2 or g.shape[1] != R.shape[0]:
+        raise ValueError(f"condition4: residuals must be (steps, {R.shape[0]}), got shape "
+                         f"{g.shape}")  # fmt: skip
+    P = lyapunov_weight(R)
+    if P is None:
+        return {"q": math.inf, "epsilon": math.inf, "start": math.inf,
+                "remainder": math.nan}  # fmt: skip
+    q = weighted_norm(R, P)
+    e = g[1:] - g[:-1] @ R.T
+    Pinv = float(np.linalg.norm(np.linalg.inv(P), 2))
+    worst = float(np.linalg.norm(e @ P.T, axis=1).max()) if len(e) else 0.0
+    eps = Pinv * worst / (1.0 - q) if q < 1.0 else math.inf
+    return {"q": q, "epsilon": eps, "start": Pinv * float(np.linalg.norm(P @ g[0])),
+            "remainder": float(np.abs(e).max()) if len(e) else 0.0}
 
 
 @dataclass

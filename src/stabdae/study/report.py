@@ -52,7 +52,18 @@ def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) ->
 
 def summary(ds: xr.Dataset) -> str:
     """Per grid point: fractions stable and bounded, δ*, median β (with the members that
-    have one) beside the predictions."""
+    have one) beside the predictions; for a boundary search, τ* with its bracket beside
+    the theory's limits."""
+    if "tau_star" in ds:
+        cols = ["tau_star", "tau_star_low", "tau_star_high", "tau_limit_floor",
+                "tau_limit_spectral", "spectral_radius", "fraction_stable"]  # fmt: skip
+        short = {"tau_star": "tau*", "tau_star_low": "low", "tau_star_high": "high",
+                 "tau_limit_floor": "tau_floor", "tau_limit_spectral": "tau_spectral",
+                 "spectral_radius": "rho(tau*)", "fraction_stable": "stable"}  # fmt: skip
+        head = ("boundary (tau*: largest stable step, between low (stable with the full "
+                "ensemble) and high; tau_floor: Theorems 6/7 with the floor the local error "
+                "forces; tau_spectral: rho(R) = 1):")  # fmt: skip
+        return "\n" + head + "\n" + grid_table(ds, cols, short, precise=cols[:5]) + "\n"
     cols = [c for c in ("fraction_stable", "fraction_bounded", "stability_radius",
                         "beta_median", "members_with_beta", "beta_ratio_median",
                         "beta_theory_discrete", "spectral_radius", "norm_condition",

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from .._boundary import boundary
 from .._ensemble import ensemble
 from .._integrate import IntegrationWarning
 from .._loading import local_imports
@@ -55,9 +56,12 @@ def axis_name(canon: str, all_names) -> str:
 
 
 def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dataset:
-    """The ensemble at one grid point, on the study's common sample grid."""
+    """The ensemble at one grid point, on the study's common sample grid (with
+    ``[search]``: the boundary search at that point)."""
     s = study.setup(values)
     ens = study.ensemble
+    if study.search is not None:
+        return search_point(study, s, threads, progress)
     with warnings.catch_warnings():  # stopped members: the study's summary counts them
         warnings.simplefilter("ignore", IntegrationWarning)
         ds = ensemble(study.model, s["law"], s["scheme"], s["tau"], s["t_end"],
@@ -75,6 +79,21 @@ def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dat
         attrs = ds.residual_norm.attrs
         ds = ds.drop_vars("residual_norm").assign_coords(time=("time", times, ds.time.attrs))
         ds["residual_norm"] = (("trace", "time"), full, attrs)
+    for key in _VOLATILE:
+        ds.attrs.pop(key, None)
+    return ds
+
+
+def search_point(study: Study, s: dict, threads=None, progress=None) -> xr.Dataset:
+    """The boundary search (:func:`stabdae.boundary`) at one grid point."""
+    ens, search = study.ensemble, study.search
+    ds = boundary(study.model, s["law"], s["scheme"], tau=search["tau"], rtol=search["rtol"],
+                  q=search["q"], members=ens["members"],
+                  search_members=search["search_members"], steps=search["steps"],
+                  t_end=search["t_end"], radius=tuple(ens["radius"]), seed=ens["seed"],
+                  params=s["params"], epsilon=s["epsilon"], divergence=s["divergence"],
+                  block=ens["block"], threads=threads,
+                  progress=progress if callable(progress) else False)  # fmt: skip
     for key in _VOLATILE:
         ds.attrs.pop(key, None)
     return ds
@@ -251,13 +270,14 @@ def _run_locked(study, out, parts, stamp, manifest, workers, scheduler, progress
             _run_dask(study, todo, parts, workers, scheduler, bar, stamp)
         else:
             for i, values in todo:
-                ds = run_point(study, values, threads=threads, progress=bar.members)
+                report = bar.note if study.search is not None else bar.members
+                ds = run_point(study, values, threads=threads, progress=report)
                 write_netcdf(_keyed(ds, i, stamp), parts / f"point-{i}.nc")
                 bar.point_done()
     finally:
         bar.close()
     ds = combine(study, parts, len(points))
-    if not study.setup()["law"].is_constant:
+    if not study.setup()["law"].is_constant and study.search is None:
         ds = _with_path_theory(study, ds)
     ds.attrs["wall_run_s"] = time.perf_counter() - start
     write_netcdf(ds, out)
@@ -319,6 +339,9 @@ def combine(study: Study, parts: Path, npoints: int) -> xr.Dataset:
     for i in range(npoints):
         with xr.open_dataset(parts / f"point-{i}.nc") as f:
             pts.append(f.load())
+    if "probe" in pts[0].dims:  # searches take different numbers of probes: pad with NaN
+        size = max(p.sizes["probe"] for p in pts)
+        pts = [p.reindex(probe=np.arange(size)) for p in pts]
     first = pts[0]
     if not names:
         ds = first
@@ -344,7 +367,8 @@ def combine(study: Study, parts: Path, npoints: int) -> xr.Dataset:
     ds.attrs["study"] = study.path.name
     ds.attrs["swept"] = ", ".join(names) if names else "nothing"
     ds.attrs["created_at"] = utc_now()
-    append_history(ds.attrs, f"stabdae run {study.path.name}: {npoints} grid points of "
+    what = "boundary searches" if study.search is not None else "grid points"
+    append_history(ds.attrs, f"stabdae run {study.path.name}: {npoints} {what} of "
                    f"{study.ensemble['members']} members combined")  # fmt: skip
     return ds
 
@@ -381,6 +405,15 @@ class _Progress:
         if self._bar is not None:
             self._bar.update(done - self._last)
             self._last = done
+
+    def note(self, text: str):
+        """A line from a boundary search (each probe)."""
+        if self._compiling:
+            self.members(0, self.members_total)
+        if self._bar is not None:
+            self._bar.set_postfix_str(text.removeprefix("boundary: "), refresh=False)
+        elif self.enabled:
+            print(f"stabdae run: {text}", file=sys.stderr)
 
     def point_done(self):
         self.done += 1

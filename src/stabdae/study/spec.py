@@ -42,9 +42,13 @@ _SECTIONS = {
             "divergence": float},  # fmt: skip
     "ensemble": {"members": int, "radius": (list, float), "seed": int, "block": int},
     "sweep": None,  # names checked against the other sections
+    "search": {"tau": dict, "q": float, "search_members": int, "steps": int,
+               "t_end": float},  # fmt: skip
     "output": {"path": str},
 }
 _REQUIRED = {"model": ("file",), "law": ("kind",), "run": ("t_end", "tau")}
+#: what a boundary search needs of [run] (τ is searched; the run length is the search's)
+_REQUIRED_SEARCH = {"model": ("file",), "law": ("kind",)}
 _LAW_KEYS = {"baumgarte": {"omega", "xi", "k"}, "matrix": {"A"}, "theorem5": {"k", "L"},
              "none": set()}  # fmt: skip
 _SWEEPABLE_RUN = ("tau",)
@@ -65,6 +69,9 @@ class Study:
     ensemble: dict
     axes: dict = field(default_factory=dict)
     output: Path | None = None
+    #: a boundary search (``[search]``): ``tau`` = (low, high), ``rtol``, ``q``,
+    #: ``search_members``, ``steps`` or ``t_end``; None for a grid of ensembles
+    search: dict | None = None
     #: the model's file (resolved), whose content, with what it imports from its own
     #: folder, keys a run's parts
     model_file: Path | None = None
@@ -128,6 +135,11 @@ class Study:
         head = (f"study {self.path.name}: model {self.model.name}, law {self.law['kind']}, "
                 f"scheme {self.scheme.get('name', 'rk2')}, {self.ensemble['members']} members "
                 f"× {self.size} grid points; swept: {axes}")  # fmt: skip
+        if self.search is not None:
+            s = self.search
+            head += (f"; searched: tau in [{s['tau'][0]:g}, {s['tau'][1]:g}] to rtol "
+                     f"{s['rtol']:g} (probes of {s['search_members']} members, confirmed "
+                     f"with {self.ensemble['members']})")  # fmt: skip
         return "\n".join([head, *self.notes])
 
 
@@ -177,7 +189,8 @@ def load_study(path, *, members: int | None = None) -> Study:
             if key not in keys:
                 fail(f"[{section}] {key}", f"unknown key; known: {', '.join(keys)}")
             raw[section][key] = _typed(val, keys[key], f"[{section}] {key}", fail)
-    for section, keys in _REQUIRED.items():
+    searching = "search" in raw
+    for section, keys in (_REQUIRED_SEARCH if searching else _REQUIRED).items():
         for key in keys:
             if key not in raw.get(section, {}):
                 fail(f"[{section}] {key}", "missing (required)")
@@ -227,6 +240,15 @@ def load_study(path, *, members: int | None = None) -> Study:
             _make_scheme(scheme)
         except SchemeError as exc:
             fail("[scheme] name", str(exc))
+
+    # search
+    search = _search(raw.get("search"), fail) if searching else None
+    if searching:
+        raw.setdefault("run", {})
+        raw["run"].setdefault("tau", search["tau"][0])
+        raw["run"].setdefault("t_end", model.t0 + search["tau"][0])
+        if any(k in ("tau", "run.tau") for k in raw.get("sweep", {})):
+            fail("[sweep] tau", "is searched in [search]; sweep the other parameters")
 
     # run
     run = dict(raw["run"])
@@ -302,7 +324,9 @@ def load_study(path, *, members: int | None = None) -> Study:
                   ensemble=ens, axes=axes,
                   output=None if output is None
                   else Path(os.path.normpath(path.parent / output)),
-                  model_file=model_file(source), notes=notes)  # fmt: skip
+                  model_file=model_file(source), notes=notes, search=search)  # fmt: skip
+    if searching:
+        return study  # τ is what the search finds: no time grid to check
 
     # every grid point must build (law shapes, time grid): try them all, cheaply
     for _, values in study.points():
@@ -315,6 +339,41 @@ def load_study(path, *, members: int | None = None) -> Study:
         except (LawError, SchemeError, ValueError, IndexError) as exc:
             raise StudyError(f"{where}: at {label}: {exc}") from None
     return study
+
+
+def _search(raw: dict, fail) -> dict:
+    """``[search] tau = { bisect = [low, high], rtol = 1e-3 }`` with ``q``,
+    ``search_members`` and ``steps`` or ``t_end``, checked."""
+    spec = raw.get("tau")
+    if spec is None:
+        fail("[search] tau", "missing: give tau = { bisect = [low, high], rtol = 1e-3 }")
+    for key in spec:
+        if key not in ("bisect", "rtol"):
+            fail(f"[search] tau.{key}", "unknown key; known: bisect, rtol")
+    ends = spec.get("bisect")
+    if not (isinstance(ends, list) and len(ends) == 2
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in ends)):
+        fail("[search] tau.bisect", f"must be [low, high], got {ends!r}")
+    lo, hi = float(ends[0]), float(ends[1])
+    if not (0 < lo < hi and math.isfinite(hi)):
+        fail("[search] tau.bisect", f"needs 0 < low < high, got {ends!r}")
+    rtol = _typed(spec.get("rtol", 1e-3), float, "[search] tau.rtol", fail)
+    if not 1e-9 <= rtol <= 1.0:
+        fail("[search] tau.rtol", f"must lie in [1e-9, 1], got {rtol:g}")
+    q = raw.get("q", 0.0)
+    if not 0.0 <= q < 1.0:
+        fail("[search] q", f"the allowed unstable fraction must lie in [0, 1), got {q:g}")
+    n = raw.get("search_members", 64)
+    if n < 1:
+        fail("[search] search_members", f"must be at least 1, got {n}")
+    if "steps" in raw and "t_end" in raw:
+        fail("[search] t_end", "give steps or t_end, not both")
+    if raw.get("steps", 1) < 1:
+        fail("[search] steps", f"must be at least 1, got {raw['steps']}")
+    if "t_end" in raw and not (math.isfinite(raw["t_end"]) and raw["t_end"] > 0):
+        fail("[search] t_end", f"must be positive and finite, got {raw['t_end']}")
+    return {"tau": (lo, hi), "rtol": rtol, "q": float(q), "search_members": n,
+            "steps": raw.get("steps"), "t_end": raw.get("t_end")}
 
 
 def _typed(val, kind, key, fail):

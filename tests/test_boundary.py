@@ -1,0 +1,124 @@
+"""The stability boundary found by bisection (stabdae.boundary), the theory's limits beside
+it, and the growth test it rests on."""
+
+from __future__ import annotations
+
+import math
+import re
+import warnings
+
+import numpy as np
+import pytest
+from affine import model as affine
+
+import stabdae
+from conftest import assert_schema, load_scene
+from stabdae import theory
+from stabdae._measures import BRACKETED, CLASSES, HIGH_END_STABLE, LOW_END_FAILS
+
+#: f̈ = −100 f − 20 ḟ (ω = 10, ξ = 1: a Jordan block) and ḣ = −10 h
+AFFINE_LAW = stabdae.matrix([[-100.0, -20.0, 0.0], [0.0, 0.0, -10.0]])
+
+
+@pytest.mark.parametrize("scheme", ["euler", "midpoint", "rk4"])
+def test_boundary_of_the_affine_system_is_the_spectral_limit(scheme):
+    """No remainder: g_{k+1} = R(τÃ) g_k exactly, so the measured boundary is ρ = 1.  Its
+    states grow without bound (the forces do not vanish), and with them the roundoff in
+    the residual, which the stable side must not mistake for growth; the divergence
+    threshold is raised so that the roundoff floor near ρ = 1 (accumulated over
+    ~1/(1 − ρ)² steps of a Jordan block) does not stop members either."""
+    ds = stabdae.boundary(affine, AFFINE_LAW, scheme, tau=(1e-3, 1.0), rtol=1e-3,
+                          members=32, search_members=16, divergence=1e12)  # fmt: skip
+    spectral = theory.tau_limit(AFFINE_LAW.A_tilde(affine), scheme)
+    assert int(ds.tau_star_reason) == BRACKETED
+    assert float(ds.tau_star_low) < float(ds.tau_star_high) <= float(ds.tau_star_low) * 1.001
+    assert float(ds.tau_star) == pytest.approx(spectral, rel=1e-3)
+    assert float(ds.tau_limit_spectral) == spectral
+    assert float(ds.fraction_stable) == 1.0 and int(ds.members_run) == 32
+    confirm = ds.probe_members.values == 32
+    assert confirm.any() and (ds.probe_stable.values[confirm] == 1).all()
+    assert_schema(ds)
+
+
+def test_boundary_of_the_pendulum_lies_between_the_floor_and_the_spectral_limit():
+    """The pendulum's remainder (its quadratic constraint, and the local error of the stiff
+    stabilization term) loses stability before ρ = 1; Theorems 6/7 with condition 4
+    guarantee ‖g‖ ≤ ε only up to where the floor the local error forces reaches ε.  RK4
+    (which damps the pendulum's own swing) over long runs."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    ds = stabdae.boundary(model, law, "rk4", tau=(1e-3, 0.3), rtol=1e-2, members=64,
+                          search_members=16, radius=(1e-8, 1e-3), epsilon=1.0)  # fmt: skip
+    star, floor = float(ds.tau_star), float(ds.tau_limit_floor)
+    spectral = float(ds.tau_limit_spectral)
+    assert int(ds.tau_star_reason) == BRACKETED
+    assert 0 < floor < float(ds.tau_star_low) and float(ds.tau_star_high) < spectral
+    assert float(ds.tau_star_high) <= float(ds.tau_star_low) * 1.01
+    assert 0.5 * spectral < star
+    # the floor limit is where the condition-4 floor along the reference path reaches ε
+    for tau, below in ((0.97 * floor, True), (1.03 * floor, False)):
+        path = stabdae.integrate(model, None, law, "rk4", tau, 2000 * tau, tau)
+        eps = theory.condition4(theory.step_matrix(law.A_tilde(model), "rk4", tau),
+                                path.residual.values)["epsilon"]  # fmt: skip
+        assert (eps <= 1.0) == below
+
+
+def test_boundary_says_when_the_bracket_does_not_hold_it():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    kw = dict(members=16, search_members=8, steps=400, rtol=0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stabdae.IntegrationWarning)
+        high = stabdae.boundary(model, law, "midpoint", tau=(0.3, 0.5), **kw)
+    low = stabdae.boundary(model, law, "midpoint", tau=(1e-3, 2e-3), **kw)
+    assert int(high.tau_star_reason) == LOW_END_FAILS and math.isnan(float(high.tau_star))
+    assert float(high.tau_star_high) == 0.3
+    assert int(low.tau_star_reason) == HIGH_END_STABLE and math.isnan(float(low.tau_star))
+    assert float(low.tau_star_low) == 2e-3 and low.sizes["probe"] == 2
+
+
+def test_boundary_errors():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    for kw, text in [({}, "tau=(low, high)"), ({"tau": 0.1}, "a pair"),
+                     ({"tau": (0.2, 0.1)}, "0 < low < high"),
+                     ({"tau": (0.1, 0.2), "q": 1.0}, "q (the allowed"),
+                     ({"tau": (0.1, 0.2), "rtol": 2.0}, "rtol must lie"),
+                     ({"tau": (0.1, 0.2), "steps": 10, "t_end": 1.0}, "not both")]:  # fmt: skip
+        with pytest.raises((TypeError, ValueError), match=r"^boundary: .*" + re.escape(text)):
+            stabdae.boundary(model, law, "midpoint", **kw)
+
+
+def test_condition4_and_forced_gain_against_closed_forms():
+    """A scalar recursion g_{k+1} = r g_k + e: P = 1, q = |r|, ε = |e|/(1 − |r|); the forced
+    gain Σ r^k = 1/(1 − r)."""
+    r, e = 0.6, 1e-3
+    g = [0.5]
+    for _ in range(200):
+        g.append(r * g[-1] + e)
+    out = theory.condition4(np.array([[r]]), np.array(g)[:, None])
+    assert out["q"] == pytest.approx(r, rel=1e-12)
+    assert out["epsilon"] == pytest.approx(e / (1 - r), rel=1e-9)
+    assert out["start"] == pytest.approx(0.5, rel=1e-12)
+    assert theory.forced_gain(np.array([[r]])) == pytest.approx(1 / (1 - r), rel=1e-5)
+    assert theory.forced_gain(np.array([[1.01]])) == math.inf
+    assert theory.condition4(np.array([[1.01]]), np.array(g)[:, None])["epsilon"] == math.inf
+
+
+def test_roundoff_growing_with_the_state_is_not_growth():
+    """The affine system's coordinates drift like t², and the residual's roundoff with
+    them: stable members at τ = 0.1 over 10⁴ steps; an unstable step is still caught."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stabdae.IntegrationWarning)
+        ds = stabdae.ensemble(affine, AFFINE_LAW, "euler", 0.1, 1000.0, members=16,
+                              traces="all", save_dt=10.0)  # fmt: skip
+        bad = stabdae.ensemble(affine, AFFINE_LAW, "euler", 0.201, 201.0, members=16,
+                               traces="none")  # fmt: skip
+    fifths = ds.residual_norm.values[:, 1:].reshape(16, 5, 20).max(axis=2)
+    assert (fifths[:, 4] > 1.5 * fifths[:, 2]).all()  # it rises, at the roundoff level
+    size = np.abs(ds.x_final.values).max(axis=1)
+    assert (size > 1e6).all() and (fifths[:, 4] < 1e3 * np.finfo(float).eps * size).all()
+    assert float(ds.fraction_stable) == 1.0
+    assert float(bad.fraction_stable) == 0.0
+    assert set(bad.stability_class.values) <= {CLASSES.index("growing"),
+                                               CLASSES.index("diverged")}
