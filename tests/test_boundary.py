@@ -122,3 +122,49 @@ def test_roundoff_growing_with_the_state_is_not_growth():
     assert float(bad.fraction_stable) == 0.0
     assert set(bad.stability_class.values) <= {CLASSES.index("growing"),
                                                CLASSES.index("diverged")}
+
+
+@pytest.mark.parametrize("scheme", ["euler", "midpoint", "heun", "rk3", "rk4"])
+def test_recommended_gain_annihilates_the_residual_of_the_affine_system(scheme):
+    """The recommended law on the affine system (whose residual follows R(τÃ) exactly):
+    the holonomic block's residual is gone after the promised steps (to roundoff), and the
+    first-order block's too where a real root allows it; elsewhere its |R(−kτ)| is the
+    smallest on a fine grid of k."""
+    tau = 0.01
+    rec = theory.recommend_gain(scheme, tau)
+    w, xi, k = rec["omega"], rec["xi"], rec["k"]
+    assert rec["rho_holonomic"] < 1e-12 and rec["steps_holonomic"] in (1, 2)
+    law = stabdae.matrix([[-w * w, -2 * xi * w, 0.0], [0.0, 0.0, -k]])
+    x0 = stabdae.sample_perturbations(affine, 1, (1e-3, 1e-3), seed=4)[0]
+    steps = max(rec["steps_holonomic"], rec["steps_first_order"])
+    g = stabdae.integrate(affine, x0[0], law, scheme, tau, affine.t0 + steps * tau,
+                          tau).residual.values  # fmt: skip
+    start = np.abs(g[0]).max()
+    assert np.abs(g[steps, :2]).max() < 1e-9 * start  # f and ḟ, to roundoff
+    if rec["steps_first_order"]:
+        assert rec["rho_first_order"] < 1e-12 and abs(g[1, 2]) < 1e-9 * start
+    else:
+        R = np.polynomial.Polynomial(stabdae.theory.as_scheme(scheme).stability_polynomial())
+        grid = np.linspace(0.0, 5.0, 50001)
+        assert rec["rho_first_order"] <= np.abs(R(-grid)).min() + 1e-12
+        assert abs(g[1, 2]) == pytest.approx(rec["rho_first_order"] * abs(g[0, 2]), rel=1e-6)
+    # no (ω, ξ) on a grid does better than deadbeat, and the next best are not deadbeat
+    A = lambda w_, x_: stabdae.matrix([[-w_ * w_, -2 * x_ * w_, 0.0],  # noqa: E731
+                                       [0.0, 0.0, -k]]).A_tilde(affine)  # fmt: skip
+    near = [theory.spectral_radius_of(A(w * f, xi * e), scheme, tau)
+            for f in (0.9, 1.1) for e in (0.9, 1.1)]  # fmt: skip
+    assert min(near) > 1e-3
+
+
+def test_recommended_gains_in_closed_form():
+    """Euler: ω = 1/τ, ξ = 1 (a double root at −1: nilpotent in 2 steps), k = 1/τ; the
+    midpoint rule: roots −1 ± i, so ω = √2/τ, ξ = 1/√2, and min |1 − x + x²/2| = 1/2 at
+    x = 1."""
+    e = theory.recommend_gain("euler", 0.02)
+    assert (e["omega"], e["xi"], e["steps_holonomic"], e["k"]) == pytest.approx((50, 1, 2, 50))
+    m = theory.recommend_gain("midpoint", 0.02)
+    assert m["omega"] == pytest.approx(math.sqrt(2) / 0.02, rel=1e-12)
+    assert m["xi"] == pytest.approx(1 / math.sqrt(2), rel=1e-12)
+    assert m["k"] == pytest.approx(50, rel=1e-8) and m["rho_first_order"] == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="recommend_gain: tau must be positive"):
+        theory.recommend_gain("rk4", 0.0)

@@ -246,6 +246,9 @@ def test_moved_tau_values_are_reported(tmp_path, capsys):
     assert main(["theory", str(path)]) == 0
     out = capsys.readouterr().out
     assert "swept tau moved onto the sample grid" in out and "cond whether |R|P < 1" in out
+    rec = stabdae.theory.recommend_gain("rk2", load_study(path).setup()["tau"])
+    assert f"Baumgarte omega = {rec['omega']:.6g}, xi = 0.707107" in out
+    assert "the residual is gone after 1 step" in out
 
 
 @pytest.mark.parametrize("name", sorted(p.name for p in (Path(__file__).resolve().parents[1]

@@ -61,6 +61,7 @@ __all__ = [
     "weighted_norm",
     "discrete",
     "tau_limit",
+    "recommend_gain",
     "condition4",
     "theorem5",
     "along_path",
@@ -361,6 +362,82 @@ def condition4(R, residuals) -> dict:
     eps = Pinv * worst / (1.0 - q) if q < 1.0 else math.inf
     return {"q": q, "epsilon": eps, "start": Pinv * float(np.linalg.norm(P @ g[0])),
             "remainder": float(np.abs(e).max()) if len(e) else 0.0}
+
+
+def recommend_gain(scheme, tau: float) -> dict:
+    """The gains that make the residual recursion contract fastest for a scheme and step:
+    the Baumgarte ``(ω, ξ)`` of a holonomic block ``f̈ + 2ξωḟ + ω²f = 0`` and the ``k`` of
+    a first-order block ``ḣ = −kh`` minimizing ``ρ(R(τÃ))``.
+
+    Deadbeat where the stability polynomial ``R`` allows it (Yoon, Howe & Greenwood,
+    J. Mech. Des. 1995): the eigenvalues of ``τÃ`` placed on roots of ``R`` with negative
+    real part make ``R(τÃ)`` nilpotent — a complex pair ``z, z̄`` (``ω = |z|/τ``,
+    ``ξ = −Re z/|z|``) or two real roots annihilate the block's residual in one step, a
+    double real root (a Jordan block, ``ξ = 1``) in two.  Among deadbeat choices the one
+    with the fewest steps, then the smallest ``ω`` (the gentlest gain).  A first-order
+    block is deadbeat at a negative real root; without one (the midpoint rule, RK4),
+    ``k`` minimizes ``|R(−kτ)|``.  Where no root qualifies, ``(ω, ξ)`` minimizes ``ρ``
+    numerically.
+
+    Returns ``omega``, ``xi``, ``rho_holonomic``, ``steps_holonomic`` (steps to
+    annihilate, 0 when not deadbeat), ``k``, ``rho_first_order``, ``steps_first_order``.
+    """
+    scheme = as_scheme(scheme)
+    tau = float(tau)
+    if not (math.isfinite(tau) and tau > 0):
+        raise ValueError(f"recommend_gain: tau must be positive and finite, got {tau!r}")
+    c = scheme.stability_polynomial()
+    R = np.polynomial.Polynomial(c)
+    roots = R.roots() if c.size > 1 else np.array([])
+    tol = 1e-9 * max(1.0, float(np.abs(roots).max(initial=0.0)))
+    left = roots[roots.real < -tol]
+    real = np.sort(left[np.abs(left.imag) <= tol].real)[::-1]  # nearest 0 first
+    pairs = left[left.imag > tol]
+    candidates = []  # (steps, ω τ, ξ)
+    for z in pairs:
+        candidates.append((1, abs(z), -z.real / abs(z)))
+    for i, z1 in enumerate(real):
+        for z2 in real[i + 1:]:
+            r = math.sqrt(z1 * z2)
+            candidates.append((1, r, -(z1 + z2) / (2.0 * r)))
+        if abs(R.deriv()(z1)) > tol:  # a simple root: the Jordan block is nilpotent of order 2
+            candidates.append((2, -z1, 1.0))
+    out = {}
+    if candidates:
+        steps, wt, xi = min(candidates)
+        out.update(omega=float(wt) / tau, xi=float(xi), steps_holonomic=steps)
+    else:
+        from scipy.optimize import minimize
+
+        def rho(v):
+            return _block_rho(c, math.exp(v[0]), v[1])
+
+        best = min((minimize(rho, [math.log(w), x], method="Nelder-Mead",
+                             options={"xatol": 1e-10, "fatol": 1e-14})
+                    for w in (0.5, 1.0, 2.0) for x in (0.5, 1.0, 1.5)),
+                   key=lambda r: r.fun)  # fmt: skip
+        out.update(omega=math.exp(best.x[0]) / tau, xi=float(best.x[1]), steps_holonomic=0)
+    out["rho_holonomic"] = _block_rho(c, out["omega"] * tau, out["xi"])
+    if real.size:
+        out.update(k=float(-real[0]) / tau, steps_first_order=1)
+    else:
+        from scipy.optimize import minimize_scalar
+
+        # |R(−x)| on the real axis; its minimum lies within the real stability interval
+        grid = np.linspace(0.0, 8.0, 8001)
+        vals = np.abs(R(-grid))
+        x0 = grid[int(np.argmin(vals))]
+        res = minimize_scalar(lambda x: abs(R(-x)), bounds=(max(0.0, x0 - 1e-3), x0 + 1e-3),
+                              method="bounded", options={"xatol": 1e-12})  # fmt: skip
+        out.update(k=float(res.x) / tau, steps_first_order=0)
+    out["rho_first_order"] = float(abs(R(-out["k"] * tau)))
+    return out
+
+
+def _block_rho(c, wt, xi) -> float:
+    """``ρ(R(τÃ))`` of one Baumgarte block with ``ωτ = wt`` and damping ``xi``."""
+    lam = np.roots([1.0, 2.0 * xi * wt, wt * wt])
+    return float(np.abs(np.polynomial.polynomial.polyval(lam, c)).max())
 
 
 @dataclass

@@ -138,6 +138,15 @@ def _cmd_theory(args) -> int:
         lims = {c_: float(ds[f"tau_limit_{c_}"].values.flat[0]) for c_ in theory.CONDITIONS}
         print("Theorems 6/7, largest tau for " + scheme.name + ": " +
               ", ".join(f"{k} {v:.6g}" for k, v in lims.items()))  # fmt: skip
+    scheme, tau = study.setup()["scheme"], study.setup()["tau"]
+    rec = theory.recommend_gain(scheme, tau)
+    how = lambda steps: (f"deadbeat: the residual is gone after {steps} step"  # noqa: E731
+                         f"{'s' if steps > 1 else ''}" if steps else "the smallest rho")
+    print(f"\nrecommended gains for {scheme.name} at tau = {tau:g} (smallest rho(R(τÃ))): "
+          f"Baumgarte omega = {rec['omega']:.6g}, xi = {rec['xi']:.6g} "
+          f"(rho {rec['rho_holonomic']:.2g}, {how(rec['steps_holonomic'])}); first-order "
+          f"k = {rec['k']:.6g} (rho {rec['rho_first_order']:.3g}, "
+          f"{how(rec['steps_first_order'])})")  # fmt: skip
     print("\nper grid point (R = R(τÃ); cond: the weighted-norm condition of Theorems 6/7):")
     print(format_table(ds))
     print("\ncolumns: rho(R) spectral radius of R(τÃ); |R|max its max-norm (the paper's); "
