@@ -305,15 +305,19 @@ def ensemble(
     wall_integrate = time.perf_counter() - clock
     status = np.where(status != 0, status, out["status"]).astype(np.int8)
     clock = time.perf_counter()
+    # the law's transient and the accumulation of per-step errors over this run (R over the
+    # run's steps, or the prediction's), from one walk over R's powers
+    peak, gain = (theory.power_norms(R, PREDICTION_STEPS if adaptive else nsteps)
+                  if R.shape[0] > 0 else (math.nan, math.inf))  # fmt: skip
     ds = _ensemble_dataset(
         model, p, law, scheme, bound, out["times"], x0, alpha0, out["norms"], traced,
         out["x_final"], status, out["fail_step"], out["e0"], out["e1"], epsilon, out["meas"],
         R, dict(**run, members=M, seed=seed, radius_low=low, radius_high=high,
                 epsilon=epsilon, divergence=divergence, sampling_rtol=SAMPLING_RTOL,
                 threads=threads if threads is not None else default_threads()),
-        extra=out.get("extra"),
-        roundoff=_roundoff(model, out["x_final"], status, p, float(out["times"][-1]), R,
-                           nsteps if not adaptive else PREDICTION_STEPS, threads),
+        extra=out.get("extra"), overshoot_theory=peak,
+        roundoff=_roundoff(model, out["x_final"], status, p, float(out["times"][-1]), gain,
+                           threads),
     )  # fmt: skip
     # wall times (compilation included on a first call) for benchmarks; not part of the data
     ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
@@ -464,11 +468,11 @@ def _warn_stopped(model, status) -> None:
 ROUNDOFF_SAMPLE = 16
 
 
-def _roundoff(model, x_final, status, p, t, R, steps, threads):
+def _roundoff(model, x_final, status, p, t, gain, threads):
     """What roundoff can build up in the residual by the end of the run: its level at the
     final states of up to ``ROUNDOFF_SAMPLE`` members that ran to the end, evenly spaced
-    (:func:`._measures.roundoff_level`), accumulated by the law's recursion
-    (:func:`.theory.forced_gain`; once where it is unknown or unbounded)."""
+    (:func:`._measures.roundoff_level`), accumulated by the law's recursion (``gain``,
+    :func:`.theory.forced_gain`; once where it is unknown or unbounded)."""
     ran = np.flatnonzero(status == 0)
     if ran.size == 0:
         return 0.0
@@ -477,13 +481,12 @@ def _roundoff(model, x_final, status, p, t, R, steps, threads):
     level = _measures.roundoff_level(
         lambda X, at: _residual_rows(model, np.ascontiguousarray(X), p, at, threads),
         x_final[pick], t)  # fmt: skip
-    gain = theory.forced_gain(R, max_steps=steps) if R.shape[0] > 0 else math.inf
     return level * (gain if math.isfinite(gain) else 1.0)
 
 
 def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
                       x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
-                      extra=None, roundoff=0.0):  # fmt: skip
+                      extra=None, roundoff=0.0, overshoot_theory=math.nan):  # fmt: skip
     C = decay
     meas[status != 0, C.C_BETA_PRED] = np.nan  # (not placed: measured on nothing)
     for c in (C.C_BETA, C.C_GAMMA):
@@ -535,9 +538,7 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
             values["beta_ratio"] = meas[:, C.C_BETA] / beta_pred
         med = _measures.median_interval(values["beta_ratio"])
         values["beta_ratio_median"] = med[0]
-        # the law's transient within this run (R over the run's steps, or the prediction's)
-        steps = run["steps"] if "steps" in run else PREDICTION_STEPS
-        values["overshoot_theory"] = theory.transient_peak(R, max_steps=steps)
+        values["overshoot_theory"] = overshoot_theory
     if model.energy is not None:
         values["energy_drift"] = e1 - e0
     values.update(extra or {})

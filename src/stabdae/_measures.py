@@ -113,7 +113,7 @@ def roundoff_level(residual_rows, states, t: float) -> float:
         G = residual_rows(X, t)
         terms = np.abs(G[0:-1:2] - G[1:-1:2]).sum(axis=0) / (2.0 * h)
         if t != 0.0:
-            Gt = residual_rows(X[-1:].repeat(2, axis=0), t * (1.0 + h))[0]
+            Gt = residual_rows(X[-1:], t * (1.0 + h))[0]
             terms = terms + np.abs(Gt - G[-1]) / h
         if np.all(np.isfinite(terms)):
             levels.append(float(terms.max()) if terms.size else 0.0)

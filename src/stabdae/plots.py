@@ -35,7 +35,7 @@ def _plt():
 
 
 def _sweep_dims(ds: xr.Dataset) -> list[str]:
-    return [d for d in ds["fraction_bounded"].dims]
+    return list(ds["tau_star" if "tau_star" in ds else "fraction_bounded"].dims)
 
 
 def _label(ds, dim) -> str:
@@ -305,13 +305,9 @@ def boundary_curve(ds: xr.Dataset, path: Path) -> Path:
     fig, ax = plt.subplots(figsize=(7.2, 5.0), constrained_layout=True)
     title = f"{ds.attrs.get('model', '')}: {ds.attrs.get('law', '')} law, " \
             f"{ds.attrs.get('scheme', '')} — largest stable step τ*"  # fmt: skip
-    dims = list(ds["tau_star"].dims)
+    dims = _sweep_dims(ds)
     if dims:
-        sub, note = ds, ""
-        if len(dims) > 1:
-            sel = {d: 0 for d in dims[1:]}
-            sub = ds.isel(sel)
-            note = ", ".join(f"{d} = {float(ds[d][0]):g}" for d in sel)
+        sub, note = _first_of_others(ds, (dims[0],))
         x = sub[dims[0]].values
         for var, style, label in (
             ("tau_limit_spectral", dict(color="black", lw=2.0), "ρ(R(τÃ)) = 1 (spectral)"),

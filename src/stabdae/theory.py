@@ -57,6 +57,7 @@ __all__ = [
     "spectral_radius_of",
     "transient_peak",
     "forced_gain",
+    "power_norms",
     "eigenvalues",
     "weighted_norm",
     "discrete",
@@ -163,18 +164,7 @@ def transient_peak(R, max_steps: int = 100_000) -> float:
     ``ω/e``-fold growth of ``‖e^{Ãt}‖`` for critically damped Baumgarte at small steps);
     ``inf`` when the powers grow past ``1e12`` (``ρ(R) ≥ 1``).  The powers are taken until
     they fall below a millionth of the peak (or ``max_steps``)."""
-    R = np.asarray(R, dtype=float)
-    P = np.eye(R.shape[0])
-    peak = 1.0
-    for _ in range(max_steps):
-        P = R @ P
-        nrm = float(np.abs(P).sum(axis=1).max())
-        if not nrm <= 1e12:
-            return math.inf
-        peak = max(peak, nrm)
-        if nrm < 1e-6 * peak:
-            break
-    return peak
+    return power_norms(R, max_steps)[0]
 
 
 def forced_gain(R, max_steps: int = 100_000) -> float:
@@ -182,18 +172,32 @@ def forced_gain(R, max_steps: int = 100_000) -> float:
     (roundoff, a local error) can accumulate in the residual recursion
     ``g_{k+1} = R g_k + e_k``; ``inf`` when the powers grow past ``1e12`` (``ρ(R) ≥ 1``).
     The sum stops when a term falls below a millionth of it."""
+    return power_norms(R, max_steps)[1]
+
+
+def power_norms(R, max_steps: int = 100_000) -> tuple[float, float]:
+    """``(transient_peak(R), forced_gain(R))`` from one walk over the powers of ``R`` (each
+    with its own stopping rule): near ``ρ = 1`` the walk is thousands of matrix products."""
     R = np.asarray(R, dtype=float)
     P = np.eye(R.shape[0])
-    total = 0.0
-    for _ in range(max_steps):
+    peak, total = 1.0, 1.0  # ‖R⁰‖ = 1 starts the sum; the peak runs over k ≥ 1
+    peak_open, total_open = max_steps >= 1, max_steps > 1
+    k = 0
+    while peak_open or total_open:
+        k += 1
+        P = R @ P
         nrm = float(np.abs(P).sum(axis=1).max())
         if not nrm <= 1e12:
-            return math.inf
-        total += nrm
-        if nrm < 1e-6 * total:
+            peak = math.inf if peak_open else peak
+            total = math.inf if total_open else total
             break
-        P = R @ P
-    return total
+        if peak_open:
+            peak = max(peak, nrm)
+            peak_open = not nrm < 1e-6 * peak and k < max_steps
+        if total_open:
+            total += nrm
+            total_open = not nrm < 1e-6 * total and k + 1 < max_steps
+    return peak, total
 
 
 def eigenvalues(A_tilde) -> np.ndarray:

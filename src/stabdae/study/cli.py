@@ -125,7 +125,8 @@ def _cmd_theory(args) -> int:
     study = load_study(args.study)
     print(study.describe())
     ds = for_study(study)
-    law = study.setup()["law"]
+    base = study.setup()
+    law = base["law"]
     if law.is_constant and not any(n.startswith(("law.", "model.")) for n in study.axes):
         A = law.A_tilde(study.model)
         c, ly = theory.continuous(A), theory.lyapunov(A)
@@ -134,11 +135,11 @@ def _cmd_theory(args) -> int:
               f"({'stable' if c['stable'] else 'NOT stable'})")
         print(f"Theorem 4: L from ÃᵀL + LÃ = −I; Sylvester on L and on the symmetric part of "
               f"−LÃ: {'holds' if ly['holds'] else 'fails'}; proven rate {ly['beta']:.6g} s-1")
-        scheme = study.setup()["scheme"]
+        scheme = base["scheme"]
         lims = {c_: float(ds[f"tau_limit_{c_}"].values.flat[0]) for c_ in theory.CONDITIONS}
         print("Theorems 6/7, largest tau for " + scheme.name + ": " +
               ", ".join(f"{k} {v:.6g}" for k, v in lims.items()))  # fmt: skip
-    scheme, tau = study.setup()["scheme"], study.setup()["tau"]
+    scheme, tau = base["scheme"], base["tau"]
     rec = theory.recommend_gain(scheme, tau)
     how = lambda steps: (f"deadbeat: the residual is gone after {steps} step"  # noqa: E731
                          f"{'s' if steps > 1 else ''}" if steps else "the smallest rho")
