@@ -204,20 +204,37 @@ def test_two_stage_sweep_changes_the_scheme_per_point(tmp_path, name):
         (("seed = 1", "seed = 1\n[sweep]\ntau = { logspace = [1e-4, 1e-2, 2000] }\n"
                       "omega = { linspace = [1, 100, 2000] }"),
          r"\[sweep\]: 4e\+06 grid points: at most 1000000"),
-        (("seed = 1", 'seed = 1\n[output]\npath = "/tmp/elsewhere.nc"'),
-         r"\[output\] path: must lie beneath the study's folder or the current one"),
-        (("seed = 1", 'seed = 1\n[output]\npath = "../up.nc"'),
-         r"\[output\] path: must lie beneath"),
     ],
 )
 def test_study_file_values_refused_before_anything_runs(tmp_path, edit, message):
     """NaN parameters, a negative seed, a block that cannot fit the thread stack, grids too
-    large to run, and an output outside the study's folder: errors naming the key, before
-    anything compiles."""
+    large to run: errors naming the key, before anything compiles."""
     text = BASE.replace(*edit)
     assert text != BASE
     with pytest.raises(StudyError, match=message):
         load_study(write(tmp_path, text))
+
+
+@pytest.mark.parametrize("path", ["/tmp/elsewhere.nc", "../up.nc"])
+def test_output_outside_the_study_folder_is_refused_unless_replaced(tmp_path, path,
+                                                                    monkeypatch):  # fmt: skip
+    """A study file writes beneath its folder or the current one: another ``[output] path``
+    is refused where it would be used, naming the key, and an output given by the caller
+    (``stabdae run -o``) replaces it."""
+    from stabdae.study.run import output_path
+
+    for sub in ("study", "cwd"):
+        (tmp_path / sub).mkdir()
+    monkeypatch.chdir(tmp_path / "cwd")
+    text = BASE.replace("seed = 1", f'seed = 1\n[output]\npath = "{path}"')
+    study = load_study(write(tmp_path / "study", text))
+    with pytest.raises(StudyError, match=r"\[output\] path: must lie beneath the study's "
+                                         r"folder or the current one"):  # fmt: skip
+        output_path(study)
+    assert output_path(study, tmp_path / "mine.nc") == tmp_path / "mine.nc"
+    inside = load_study(write(tmp_path / "study", BASE.replace(
+        "seed = 1", 'seed = 1\n[output]\npath = "out/x.nc"'), "inside.toml"))  # fmt: skip
+    assert output_path(inside) == tmp_path / "study" / "out" / "x.nc"
 
 
 def test_a_tableau_in_the_study_file(tmp_path):

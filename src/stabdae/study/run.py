@@ -33,7 +33,7 @@ from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
 from ..kernels.cache import library_fingerprint
 from .report import summary
-from .spec import Study, load_study
+from .spec import Study, StudyError, load_study
 from .theory import axis_units, for_study
 
 __all__ = ["run_study", "run_point", "combine"]
@@ -135,6 +135,8 @@ def output_path(study: Study, output=None) -> Path:
     one written with a trailing slash — which gets ``<study>.nc``), else the study's
     ``[output] path``, else ``results/<study>.nc``."""
     if output is None:
+        if study.output_refused:
+            raise StudyError(study.output_refused)
         return study.output or Path("results") / f"{study.path.stem}.nc"
     out = Path(output)
     if out.is_dir() or str(output).endswith(("/", "\\")):

@@ -77,6 +77,9 @@ class Study:
     model_file: Path | None = None
     #: what validation changed and the user should know (printed with the description)
     notes: list = field(default_factory=list)
+    #: why ``output`` may not be written (it lies outside the study's folder and the
+    #: current one), or None
+    output_refused: str | None = None
 
     # ----------------------------------------------------------------- grid
     @property
@@ -314,17 +317,21 @@ def load_study(path, *, members: int | None = None) -> Study:
                          f"divides t_end): {', '.join(moved)}")  # fmt: skip
 
     output = raw.get("output", {}).get("path")
+    refused = None
     if output is not None:  # a study file is data: it writes beneath its folder or here
         target = Path(os.path.normpath(path.parent.resolve() / output))
         if not any(target.is_relative_to(base) and target != base
                    for base in (path.parent.resolve(), Path.cwd().resolve())):  # fmt: skip
-            fail("[output] path", f"must lie beneath the study's folder or the current one, "
-                 f"got {output!r} (give another place with stabdae run -o)")  # fmt: skip
+            # refused where it would be used: an output given by the caller replaces it
+            refused = (f"{where}: [output] path: must lie beneath the study's folder or the "
+                       f"current one, got {output!r} (give another place with stabdae run "
+                       f"-o)")  # fmt: skip
     study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
                   ensemble=ens, axes=axes,
                   output=None if output is None
                   else Path(os.path.normpath(path.parent / output)),
-                  model_file=model_file(source), notes=notes, search=search)  # fmt: skip
+                  model_file=model_file(source), notes=notes, search=search,
+                  output_refused=refused)  # fmt: skip
     if searching:
         return study  # τ is what the search finds: no time grid to check
 
