@@ -28,7 +28,12 @@ machine vary by 10 % from run to run); the others run once.
 Usage::
 
     python studies/bench_throughput.py [--members 10000 100000] [--repeat 3]
+                                       [--t-end 10 2] [--baseline REV]
                                        [--out studies/results]
+
+``--baseline REV`` times ``stabdae.ensemble`` of an earlier revision as well (a git
+worktree in a second process with its own kernel cache; its runs alternate with this
+revision's), e.g. the cost of measuring every member's decay at every step.
 """
 
 from __future__ import annotations
@@ -81,25 +86,26 @@ def run_c(fn, x0):
     return time.perf_counter() - start, xf
 
 
-def run_kernel(model, law, x0, divergence):
-    """stabdae's ensemble kernel alone, as ``stabdae.ensemble`` calls it."""
+def run_kernel(model, law, x0, divergence, nsteps):
+    """stabdae's ensemble kernel alone, with the inputs and outputs ``stabdae.ensemble``
+    gives it (the reference trajectory's residuals, the linear prediction's ``R``; every
+    member traced, as the C stores every member's norms)."""
+    from stabdae import _ensemble as E
     from stabdae._laws import bind_law
     from stabdae._schemes import as_scheme
-    from stabdae.kernels.ensemble import BLOCK, ensemble_kernel_for
-    from stabdae.kernels.threads import run_chunks
+    from stabdae.kernels.ensemble import BLOCK
 
     bound, scheme = bind_law(law, model), as_scheme("midpoint")
-    kernel = ensemble_kernel_for(model, bound, scheme, BLOCK)
-    M, p = x0.shape[0], model.param_vector(None)
-    norms = np.empty((M, NSTEPS // SAVE_EVERY + 1), dtype=np.float32)
-    xf, status, fail = np.empty_like(x0), np.empty(M, np.int8), np.empty(M, np.int64)
-    e0, e1 = np.empty(M), np.empty(M)
+    p, t0, M = model.param_vector(None), model.t0, x0.shape[0]
+    alpha0 = E._residual_rows(model, x0, p, t0)
+    g_ref = E._reference_residuals(model, bound, scheme, p, t0, TAU, nsteps)
+    R, _ = E._prediction(law, model, scheme, TAU, nsteps * TAU)
+    trace_row, traced = E._trace_rows("all", M, "bench")
     start = time.perf_counter()
-    run_chunks(lambda lo, hi: kernel(x0, model.t0, TAU, NSTEPS, SAVE_EVERY, p, bound.matrix,
-                                     bound.scalars, scheme.A, scheme.b, scheme.c, divergence,
-                                     norms, xf, status, fail, e0, e1, lo, hi),
-               -(-M // BLOCK))  # fmt: skip
-    return time.perf_counter() - start, xf
+    out = E._run_fixed(model, bound, scheme, x0, alpha0, p, t0, TAU, nsteps, SAVE_EVERY,
+                       BLOCK, divergence, g_ref, R, trace_row, traced, "float32", None,
+                       None)  # fmt: skip
+    return time.perf_counter() - start, out["x_final"]
 
 
 def run_numpy(x0):
@@ -177,6 +183,54 @@ def second_process_start() -> float:
     return float(out.stdout.strip().splitlines()[-1])
 
 
+_BASELINE_SERVER = """
+import sys, time, numpy as np, stabdae
+model = stabdae.load_model("pendulum")
+law = stabdae.baumgarte(float(sys.argv[1]), float(sys.argv[2]))
+for line in sys.stdin:
+    path, t_end, tau, save_dt = line.split()
+    x0 = np.load(path)
+    start = time.perf_counter()
+    ds = stabdae.ensemble(model, law, "midpoint", float(tau), float(t_end), x0=x0,
+                          save_dt=float(save_dt))
+    secs = time.perf_counter() - start
+    np.save(path + ".xf.npy", ds.x_final.values)
+    print(secs, flush=True)
+"""
+
+
+class Baseline:
+    """``stabdae.ensemble`` of an earlier revision (a git worktree of ``rev``), in a second
+    process with its own kernel cache, timed on request so that its runs alternate with
+    this revision's (the two never run at once)."""
+
+    def __init__(self, rev: str):
+        self.dir = Path(tempfile.mkdtemp(prefix="stabdae-baseline-"))
+        subprocess.run(["git", "-C", str(HERE.parent), "worktree", "add", "--detach",
+                        str(self.dir / "tree"), rev], check=True, capture_output=True)  # fmt: skip
+        self.rev = subprocess.run(["git", "-C", str(self.dir / "tree"), "rev-parse", "HEAD"],
+                                  check=True, capture_output=True, text=True).stdout.strip()
+        env = dict(os.environ, PYTHONPATH=str(self.dir / "tree" / "src"),
+                   STABDAE_CACHE_DIR=str(self.dir / "cache"))  # fmt: skip
+        self.proc = subprocess.Popen([sys.executable, "-c", _BASELINE_SERVER, str(OMEGA),
+                                      str(XI)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     text=True, env=env, cwd=str(self.dir))  # fmt: skip
+
+    def run(self, x0, t_end):
+        path = str(self.dir / "x0.npy")
+        np.save(path, x0)
+        self.proc.stdin.write(f"{path} {t_end!r} {TAU!r} {SAVE_DT!r}\n")
+        self.proc.stdin.flush()
+        secs = float(self.proc.stdout.readline())
+        return secs, np.load(path + ".xf.npy")
+
+    def close(self):
+        self.proc.stdin.close()
+        self.proc.wait()
+        subprocess.run(["git", "-C", str(HERE.parent), "worktree", "remove", "--force",
+                        str(self.dir / "tree")], check=False, capture_output=True)  # fmt: skip
+
+
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--members", type=int, nargs="+", default=[10_000, 100_000])
@@ -184,8 +238,15 @@ def main(argv=None) -> dict:
                         help="NumPy is slow: run it at this size only")  # fmt: skip
     parser.add_argument("--repeat", type=int, default=3,
                         help="runs of the API, kernel and blocked C variants (best kept)")
+    parser.add_argument("--t-end", type=float, nargs="+", default=[T_END],
+                        help="run lengths (s); 2 s: runs short enough that what the API does "
+                             "besides integrating shows")  # fmt: skip
+    parser.add_argument("--baseline", metavar="REV",
+                        help="also time stabdae.ensemble of this git revision (a worktree, "
+                             "a second process), alternating with this one")  # fmt: skip
     parser.add_argument("--out", default=str(HERE / "results"))
     args = parser.parse_args(argv)
+    global T_END, NSTEPS
 
     # before libgomp is loaded (build_c): its workers must not spin after a C run
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
@@ -211,27 +272,44 @@ def main(argv=None) -> dict:
     print(f"stabdae compile (first call of a new model, tiny ensemble): {compile_s:.2f} s; "
           f"a second process, import to first ensemble done: {warm_s:.2f} s; "
           f"threads: {report['threads']}")
-    for M in args.members:
+    baseline = Baseline(args.baseline) if args.baseline else None
+    if baseline:
+        report["baseline_rev"] = baseline.rev
+        baseline.run(ds.x0.values, 10 * TAU)  # its compilation, outside the timings
+    configs = [(t, M) for t in args.t_end for M in args.members]
+    for T_END, M in configs:
+        NSTEPS = round(T_END / TAU)
         x0, _, _ = stabdae.sample_perturbations(model, M, (1e-6, 1e-2), seed=1)
         steps = M * NSTEPS
-        api = kernel = t_blocked = t_ieee = np.inf
+        api = api_all = kernel = t_blocked = t_ieee = t_base = np.inf
         for _ in range(max(1, args.repeat)):  # in turn, best of each
             start = time.perf_counter()
             ds = stabdae.ensemble(model, law, "midpoint", TAU, T_END, x0=x0, save_dt=SAVE_DT)
             api = min(api, time.perf_counter() - start)
-            t, xf_kernel = run_kernel(model, law, x0, ds.attrs["divergence"])
+            start = time.perf_counter()  # every member's norms stored, as the C does
+            stabdae.ensemble(model, law, "midpoint", TAU, T_END, x0=x0, save_dt=SAVE_DT,
+                             traces="all")  # fmt: skip
+            api_all = min(api_all, time.perf_counter() - start)
+            t, xf_kernel = run_kernel(model, law, x0, ds.attrs["divergence"], NSTEPS)
             kernel = min(kernel, t)
+            if baseline:
+                t, xf_base = baseline.run(x0, T_END)
+                t_base = min(t_base, t)
             t, xf_blocked = run_c(lib.run_blocked, x0)
             t_blocked = min(t_blocked, t)
             t_ieee = min(t_ieee, run_c(lib_ieee.run_blocked, x0)[0])
         assert np.array_equal(xf_kernel, ds.x_final.values)
         t_scalar, xf_scalar = run_c(lib.run_scalar, x0)
         xs = ds.x_final.values
-        row = {"members": M, "member_steps": steps, "repeat": max(1, args.repeat),
-               "stabdae_api_s": api, "stabdae_kernel_s": kernel,
+        row = {"members": M, "t_end": T_END, "member_steps": steps,
+               "repeat": max(1, args.repeat), "stabdae_api_s": api,
+               "stabdae_api_all_traces_s": api_all, "stabdae_kernel_s": kernel,
                "c_scalar_s": t_scalar, "c_blocked_s": t_blocked,
                "c_blocked_no_fma_s": t_ieee,
                "max_diff_vs_c": float(np.max(np.abs(xs - xf_blocked)))}  # fmt: skip
+        if baseline:
+            row["baseline_api_s"] = t_base
+            row["baseline_same_final_states"] = bool(np.array_equal(xf_base, xs))
         if M <= args.numpy_members:
             row["numpy_s"], xf_np = run_numpy(x0)
             row["max_diff_numpy_vs_c"] = float(np.max(np.abs(xf_np - xf_blocked)))
@@ -239,19 +317,28 @@ def main(argv=None) -> dict:
         if jax_run is not None:
             row["jax_s"], _, row["jax_compile_s"] = jax_run
         report["runs"].append(row)
-        print(f"\nmembers = {M}: {steps:.3g} member-steps "
+        print(f"\nmembers = {M}, t_end = {T_END:g} s: {steps:.3g} member-steps "
               f"(final states agree with C to {row['max_diff_vs_c']:.1e})")
-        print(f"{'variant':<28} {'seconds':>9} {'member-steps/s':>15} {'÷ vectorized C':>15}")
-        variants = [("stabdae ensemble (public API)", api), ("stabdae kernel only", kernel),
-                    ("C, one member per iteration", t_scalar),
-                    ("C, blocked + vectorized", t_blocked),
-                    ("C, blocked, -ffp-contract=off", t_ieee)]  # fmt: skip
+        print(f"{'variant':<34} {'seconds':>9} {'member-steps/s':>15} {'÷ vectorized C':>15}")
+        variants = [("stabdae ensemble (public API)", api),
+                    ("  the same, every member traced", api_all),
+                    ("stabdae kernel only", kernel)]  # fmt: skip
+        if baseline:
+            variants.append((f"stabdae API at {baseline.rev[:10]}", t_base))
+        variants += [("C, one member per iteration", t_scalar),
+                     ("C, blocked + vectorized", t_blocked),
+                     ("C, blocked, -ffp-contract=off", t_ieee)]  # fmt: skip
         if "numpy_s" in row:
             variants.append(("NumPy over members", row["numpy_s"]))
         if "jax_s" in row:
             variants.append(("JAX scan + vmap", row["jax_s"]))
         for name, secs in variants:
-            print(f"{name:<28} {secs:9.3f} {steps / secs:15.3g} {t_blocked / secs:15.3f}")
+            print(f"{name:<34} {secs:9.3f} {steps / secs:15.3g} {t_blocked / secs:15.3f}")
+        if baseline:
+            print(f"this revision's API over {baseline.rev[:10]}'s: {t_base / api:.3f} "
+                  f"(same final states: {row['baseline_same_final_states']})")
+    if baseline:
+        baseline.close()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "bench_throughput.json").write_text(json.dumps(report, indent=2))

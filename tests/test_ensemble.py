@@ -18,6 +18,7 @@ from numba import njit
 import stabdae
 from conftest import ROOT, assert_schema, load_scene
 from stabdae._schema import write_netcdf
+from stabdae.kernels import decay
 from stabdae.kernels.ensemble import CHECKPOINT
 from stabdae.kernels.fma import HOST_FMA
 
@@ -38,15 +39,21 @@ def baumgarte_ensemble(name, scheme, xi, **kw):
 @pytest.mark.parametrize("name", ["pendulum", "double_pendulum"])
 def test_beta_matches_discrete_prediction(name, scheme, xi):
     """Median β within 2 % of −ln ρ(R(τÃ))/τ (5 % under-damped) and each member's β within
-    1 % of its linear prediction's: under-damped (an oscillating residual), critically
-    damped (repeated eigenvalue, Euler's R(τÃ) a Jordan block) and over-damped."""
+    1 % of its linear prediction's (2 % at the largest perturbations): under-damped (an
+    oscillating residual), critically damped (repeated eigenvalue, Euler's R(τÃ) a Jordan
+    block) and over-damped."""
     ds = baumgarte_ensemble(name, scheme, xi)
     assert (ds.status == 0).all()
     predicted = float(ds.beta_theory_discrete)
     # an under-damped residual's fit window holds one or two of its periods here
     assert abs(float(ds.beta_median) / predicted - 1) <= (0.02 if xi >= 1 else 0.05)
     ratio = ds.beta_ratio.values
-    assert np.mean(np.abs(ratio - 1) < 0.01) >= 0.95  # measured over the linear prediction
+    # measured over the linear prediction; the largest perturbations (‖α⁰‖ near 0.1, a
+    # tenth of the rods' length) leave the linear regime: Euler's quadratic terms move
+    # the double pendulum's rate there by up to 1.4 %
+    small = ds.alpha0_norm.values <= 0.05
+    assert np.mean(np.abs(ratio[small] - 1) < 0.01) >= 0.95
+    assert np.all(np.abs(ratio - 1) < 0.02)
     if scheme == "euler" and xi == 1.0:  # here discrete and continuous rates differ by 5 %
         assert abs(float(ds.beta_theory) / predicted - 1) > 0.04
 
@@ -612,3 +619,27 @@ def test_members_stopped_by_a_status_keep_their_last_good_state():
             one = stabdae.integrate(model, x0[j], law, "rk4", 1e-3, 1.0, 1e-3)
         assert one.attrs["steps_completed"] == steps[j]
         np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[steps[j]])
+
+
+@pytest.mark.parametrize("scheme", ["euler", "midpoint", "rk4"])
+@pytest.mark.parametrize("xi", [0.3, 1.0, 3.0])
+def test_one_step_map_gives_the_discrete_rate_of_a_short_transient(scheme, xi):
+    """On the affine system the residual follows ``g_{k+1} = R(τÃ) g_k`` exactly.  Over a
+    short run (six time constants of the slowest mode: two decades or less, with the
+    polynomial prefactor of a critically damped law, the beat of an under-damped one or
+    the fast mode of an over-damped one) every member's β is ``−ln ρ(R)/τ`` to 1e-4: the
+    one-step map fitted to its pairs is R (to roundoff, which moves a Jordan block's
+    eigenvalue by its square root).  (A fit of the norm's envelope over such a
+    window is off by up to half.)"""
+    from affine import model as affine
+
+    slowest = xi if xi < 1 else xi - math.sqrt(xi * xi - 1)  # ω = 1
+    law = stabdae.matrix([[-1.0, -2 * xi, 0.0], [0.0, 0.0, -5.0]])
+    ds = stabdae.ensemble(affine, law, scheme, 0.01, round(6 / slowest, 2), members=32,
+                          radius=(1e-6, 1e-3), seed=2, traces="none")  # fmt: skip
+    predicted = float(ds.beta_theory_discrete)
+    assert abs(predicted / slowest - 1) < 0.05
+    assert int(ds.members_with_beta) == 32
+    np.testing.assert_allclose(ds.beta.values, predicted, rtol=1e-4)
+    np.testing.assert_allclose(ds.beta_ratio.values, 1.0, rtol=1e-4)
+    assert set(ds.fit_kind.values.tolist()) == {decay.K_MAP}

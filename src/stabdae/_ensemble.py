@@ -405,9 +405,12 @@ def _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every,
     kernel = ensemble_kernel_for(model, bound, scheme, block)
     alpha0 = np.ascontiguousarray(alpha0)
 
+    pooled = _pooled(model, bound.law)
+
     def chunk(lo, hi):
         kernel(x0, alpha0, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
-               scheme.A, scheme.b, scheme.c, divergence, g_ref, R, trace_row, out["norms"],
+               scheme.A, scheme.b, scheme.c, divergence, g_ref, R, pooled, trace_row,
+               out["norms"],
                out["meas"], out["x_final"], out["status"], out["fail_step"], out["e0"],
                out["e1"], lo, hi)  # fmt: skip
 
@@ -417,6 +420,28 @@ def _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every,
         else lambda done, _: progress(min(M, done * block), M),
     )  # fmt: skip
     return out
+
+
+def _pooled(model, law) -> int:
+    """The number of holonomic constraints when the constant law acts alike on every
+    constraint (``Ã``'s blocks multiples of the identity, no coupling between f and h:
+    Baumgarte's law), so that the decay measurement pools their pairs into one 2 × 2
+    and one 1 × 1 map; −1 otherwise."""
+    if not law.is_constant:
+        return -1
+    A = law.A_tilde(model)
+    m, k = model.m, model.k
+    f, fd, h = slice(0, m), slice(m, 2 * m), slice(2 * m, 2 * m + k)
+
+    def scalar(block):
+        return block.size == 0 or np.array_equal(block, block[0, 0] * np.eye(block.shape[0]))
+
+    def zero(block):
+        return not np.any(block)
+
+    ok = (scalar(A[fd, f]) and scalar(A[fd, fd]) and scalar(A[h, h]) and zero(A[fd, h])
+          and zero(A[h, f]) and zero(A[h, fd]))  # fmt: skip
+    return m if ok else -1
 
 
 def _run_adaptive(model, bound, x0, alpha0, status, p, t0, save_times, rtol, atol,

@@ -88,7 +88,8 @@ SCHEMA: dict[str, tuple] = {
                          "growth", "1", {}),
     "fit_start": ("member", "start of the window beta is fitted on", "s", {}),
     "fit_end": ("member", "end of the window beta is fitted on", "s", {}),
-    "fit_points": ("member", "right-envelope points in the fit window", "1", {}),
+    "fit_points": ("member", "right-envelope points in the fit window (pairs of the "
+                   "one-step map)", "1", {}),
     "fit_kind": ("member", "kind of decay fit", "1", _flags(KINDS)),
     "beta_predicted": ("member", "beta of the member's linear prediction R^k alpha0 (or "
                        "exp(A~ t) alpha0), same window and fit", "s-1", {}),

@@ -101,10 +101,35 @@ REASONS = {
     R_NOT_DECAYING: "not decaying",
 }
 #: kinds of fit (``fit_kind``)
-K_NONE, K_EXPONENTIAL, K_POLYNOMIAL, K_OSCILLATING = 0, 1, 2, 3
+K_NONE, K_EXPONENTIAL, K_POLYNOMIAL, K_OSCILLATING, K_MAP = 0, 1, 2, 3, 4
 KINDS = {K_NONE: "none", K_EXPONENTIAL: "exponential",
          K_POLYNOMIAL: "exponential with polynomial prefactor",
-         K_OSCILLATING: "oscillating (level times regressed on levels)"}  # fmt: skip
+         K_OSCILLATING: "oscillating (level times regressed on levels)",
+         K_MAP: "one-step map (spectral radius of the fitted g_k -> g_k+1)"}  # fmt: skip
+
+#: the one-step map is fitted for residuals of at most this many components (its sums
+#: take 2 ng² numbers per bin and member)
+MAP_MAX_NG = 12
+#: its pairs are binned by the ladder level of ``‖g_k‖`` in bins of ``2^MAP_SHIFT``
+#: levels (two octaves)
+MAP_SHIFT = 4
+MAP_BINS = NBINS >> MAP_SHIFT
+#: eigenvalues of a fitted map whose rates differ by less than this fraction count as
+#: one repeated eigenvalue (:func:`_cluster_radius`); the rate read is then off by at most
+#: half of it
+CLUSTER = 0.02
+#: directions of the whitened pairs with less than this fraction of the largest's sum
+#: of squares are left out of the fit (no transient moves there: what is seen there is
+#: the floor's motion)
+MAP_RANK_TOL = 1e-12
+#: the pairs used lie above this many times the floor (then ``FLOOR_MARGIN``)
+MAP_MARGIN = 100.0
+#: all pairs are used when the largest norm fell from each of the last three fifths to
+#: the next, by this factor from the third to the fifth: the run ended inside the
+#: transient, where the largest norm of the last fifth is no floor (the map needs no
+#: window that ends above a floor, so a slower fall than the envelope's
+#: ``STILL_DECAYING`` suffices)
+MAP_STILL_DECAYING = 2.0
 
 
 # --------------------------------------------------------------------- the ladder
@@ -534,13 +559,20 @@ def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
 
 
 @njit(cache=True)
-def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g, gn):
+def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g, gn,
+            rho_R=math.nan):  # fmt: skip
     """Member ``row``'s predicted rate: ``g_{k+1} = R g_k`` from ``g_0 = alpha`` over the
     steps up to its fit window's end, through ladder row ``j``, fitted over the measured
-    window with the measured kind.  ``g``, ``gn`` are scratch of the residual's size."""
+    window with the measured kind; ``−ln ρ(R)/h`` for a member measured by its one-step
+    map (``rho_R``: ``ρ(R)`` when known).  ``g``, ``gn`` are scratch of the residual's
+    size."""
     out = meas[row]
     out[C_BETA_PRED] = math.nan
     if out[C_REASON] != R_FITTED:
+        return
+    if out[C_KIND] == K_MAP:  # the map fitted to g_{k+1} = R g_k is R itself
+        rho = rho_R if rho_R == rho_R else spectral_radius_of(R)
+        out[C_BETA_PRED] = -math.log(rho) / h
         return
     ng = alpha.shape[0]
     ladder_clear(lt, j)
@@ -568,6 +600,267 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g
             lv[j, lev] = nrm
     n = records(lt, lv, j, rt, ry)
     out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, out[C_KIND], h, a, b, lg)
+
+
+# --------------------------------------------------------------------- one-step map
+@njit(cache=True)
+def map_buffers(rows, ng, pm):
+    """The one-step map's buffers for ``rows`` members at a time: per member and bin the
+    sums of the pairs' outer products and their number; each member's previous ``g``,
+    its ladder level and the last step whose pair was added.
+
+    With ``pm ≥ 0`` the law acts alike on each of the ``pm`` holonomic constraints (one
+    2 × 2 block on every ``(f_i, ḟ_i)``) and on each nonholonomic one (one number on
+    every ``h_j``): the pairs of all constraints are pooled into one 2 × 2 and one 1 × 1
+    fit (11 sums).  Otherwise the full ``ng × ng`` map is fitted (``2 ng² + 1`` sums),
+    for residuals of at most ``MAP_MAX_NG`` components (none above: no bins)."""
+    if pm >= 0:
+        width = 11
+    else:
+        width = 2 * ng * ng + 1 if ng <= MAP_MAX_NG else 0
+    S = np.zeros((rows, MAP_BINS if width else 0, width))
+    prev = np.zeros((rows, ng))
+    plev = np.zeros(rows, dtype=np.int64)
+    upto = np.zeros(rows, dtype=np.int64)
+    return S, prev, plev, upto
+
+
+@njit(cache=True)
+def map_begin(S, upto, j):
+    """Clear slot ``j``'s sums for a new member."""
+    for b in range(S.shape[1]):
+        for c in range(S.shape[2]):
+            S[j, b, c] = 0.0
+    upto[j] = 0
+
+
+@njit(cache=True)
+def map_observe(S, prev, plev, upto, j, k, D, level, pm):
+    """State ``k``'s residual ``D[:, j]`` (its norm at ladder ``level``) of slot ``j``:
+    the pair (state k − 1, state k) is added to the bin of the earlier state's level,
+    once (steps done again after a rollback bring the same pairs: they are not added
+    twice, so the sums do not depend on the block's other members).  ``pm``: as in
+    :func:`map_buffers`."""
+    ng = prev.shape[1]
+    if k >= 1 and k > upto[j] and S.shape[2] > 0:
+        b = plev[j] >> MAP_SHIFT
+        if pm >= 0:  # pooled: Σ p pᵀ, Σ p' pᵀ over p = (f_i, ḟ_i); Σ h², Σ h' h
+            for i in range(pm):
+                a0, a1 = prev[j, i], prev[j, pm + i]
+                c0, c1 = D[i, j], D[pm + i, j]
+                S[j, b, 0] += a0 * a0
+                S[j, b, 1] += a0 * a1
+                S[j, b, 2] += a1 * a0
+                S[j, b, 3] += a1 * a1
+                S[j, b, 4] += c0 * a0
+                S[j, b, 5] += c0 * a1
+                S[j, b, 6] += c1 * a0
+                S[j, b, 7] += c1 * a1
+            for i in range(2 * pm, ng):
+                S[j, b, 8] += prev[j, i] * prev[j, i]
+                S[j, b, 9] += D[i, j] * prev[j, i]
+            S[j, b, 10] += 1.0
+        else:
+            c = 0
+            for r in range(ng):
+                pr = prev[j, r]
+                for q in range(ng):
+                    S[j, b, c] += pr * prev[j, q]
+                    c += 1
+            for r in range(ng):
+                dr = D[r, j]
+                for q in range(ng):
+                    S[j, b, c] += dr * prev[j, q]
+                    c += 1
+            S[j, b, c] += 1.0
+        upto[j] = k
+    for r in range(ng):
+        prev[j, r] = D[r, j]
+    plev[j] = level
+
+
+@njit(cache=True)
+def _cluster_radius(moduli, n):
+    """The largest modulus, or the geometric mean of those within ``CLUSTER`` of it in
+    rate (``ln`` of the modulus): a repeated eigenvalue (a Jordan block, as critically
+    damped laws give) splits by the square root of a perturbation of the matrix, its
+    mean by the perturbation itself."""
+    top = 0.0
+    for i in range(n):
+        top = max(top, moduli[i])
+    if not (top > 0.0) or top == math.inf:
+        return top
+    width = CLUSTER * abs(math.log(top))
+    logs = 0.0
+    count = 0
+    for i in range(n):
+        if moduli[i] > 0.0 and math.log(top / moduli[i]) <= width:
+            logs += math.log(moduli[i])
+            count += 1
+    return math.exp(logs / count)
+
+
+@njit(cache=True)
+def spectral_radius_of(R):
+    """``ρ(R)`` of a small real matrix (closed form up to 2 × 2), where eigenvalues of
+    nearly the same modulus count as one repeated eigenvalue (:func:`_cluster_radius`):
+    the rate an ensemble measures from a fitted map, and the one a finite run shows."""
+    n = R.shape[0]
+    if n == 1:
+        return abs(R[0, 0])
+    moduli = np.empty(n)
+    if n == 2:  # (NaN for non-finite entries, like the eigenvalues below)
+        half = 0.5 * (R[0, 0] + R[1, 1])
+        det = R[0, 0] * R[1, 1] - R[0, 1] * R[1, 0]
+        disc = half * half - det
+        if disc < 0.0:
+            return math.sqrt(det)
+        moduli[0] = abs(half + math.sqrt(disc))
+        moduli[1] = abs(half - math.sqrt(disc))
+        return _cluster_radius(moduli, 2)
+    for i in range(n):
+        for q in range(n):
+            if not math.isfinite(R[i, q]):
+                return math.nan
+    # complex input: numba's real eigvals refuses complex eigenvalues
+    lam = np.linalg.eigvals(R.astype(np.complex128))
+    for i in range(n):
+        moduli[i] = abs(lam[i])
+    return _cluster_radius(moduli, n)
+
+
+@njit(cache=True)
+def _pooled_radius(S, j, first):
+    """``ρ`` of the pooled fits (:func:`map_buffers`): the larger of the 2 × 2 map of
+    the ``(f_i, ḟ_i)`` pairs and the 1 × 1 map of the ``h_j``, each where it has data;
+    the number of pairs."""
+    s = np.zeros(11)
+    for b in range(first, S.shape[1]):
+        for c in range(11):
+            s[c] += S[j, b, c]
+    rho = -1.0
+    det = s[0] * s[3] - s[1] * s[2]
+    if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:
+        R = np.empty((2, 2))  # S1 S0⁻¹
+        R[0, 0] = (s[4] * s[3] - s[5] * s[2]) / det
+        R[0, 1] = (s[5] * s[0] - s[4] * s[1]) / det
+        R[1, 0] = (s[6] * s[3] - s[7] * s[2]) / det
+        R[1, 1] = (s[7] * s[0] - s[6] * s[1]) / det
+        rho = spectral_radius_of(R)
+    if s[8] > 0.0:
+        rho = max(rho, abs(s[9] / s[8]))
+    return (rho if rho >= 0.0 else math.nan), s[10]
+
+
+@njit(cache=True)
+def _map_radius(S, j, ng, first):
+    """``ρ`` of the least-squares one-step map ``R̂ = S1 S0⁻¹`` from the bins of slot
+    ``j`` from ``first`` up, on the directions its pairs span, and the number of pairs;
+    NaN with fewer than ``2 ng`` pairs."""
+    S0 = np.zeros((ng, ng))
+    S1 = np.zeros((ng, ng))
+    pairs = 0.0
+    for b in range(first, S.shape[1]):
+        c = 0
+        for r in range(ng):
+            for q in range(ng):
+                S0[r, q] += S[j, b, c]
+                c += 1
+        for r in range(ng):
+            for q in range(ng):
+                S1[r, q] += S[j, b, c]
+                c += 1
+        pairs += S[j, b, c]
+    if pairs < 2.0 * ng:
+        return math.nan, pairs
+    # Whitened (each component scaled to unit sum of squares) and restricted to the
+    # directions the pairs span: Baumgarte's law acts alike on every constraint, so the
+    # residual of m constraints moves in a plane of its 2m dimensions, and a fit over all
+    # of them gives the remaining directions the floor's dynamics.
+    w = np.zeros(ng)
+    for r in range(ng):
+        if S0[r, r] > 0.0:
+            w[r] = 1.0 / math.sqrt(S0[r, r])
+    for r in range(ng):
+        for q in range(ng):
+            S0[r, q] *= w[r] * w[q]
+            S1[r, q] *= w[r] * w[q]
+    lam, U = np.linalg.eigh(S0)
+    top = lam[ng - 1]
+    if not (top > 0.0):
+        return math.nan, pairs
+    keep = 0
+    for i in range(ng):
+        if lam[i] >= MAP_RANK_TOL * top:
+            keep += 1
+    V = np.ascontiguousarray(U[:, ng - keep:])
+    # R̂ on that subspace: (Vᵀ S1 V)(Vᵀ S0 V)⁻¹, Vᵀ S0 V the kept eigenvalues
+    Rr = np.ascontiguousarray(V.T) @ S1 @ V
+    for q in range(keep):
+        for r in range(keep):
+            Rr[r, q] /= lam[ng - keep + q]
+    return spectral_radius_of(Rr), pairs
+
+
+@njit(cache=True)
+def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry):
+    """β of member ``row`` from its one-step map, replacing the envelope's fit.
+
+    The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
+    still decaying (``MAP_STILL_DECAYING``), else those from its start down to
+    ``MAP_MARGIN`` (then ``FLOOR_MARGIN``) times its floor, give ``R̂`` by least
+    squares; ``β = −ln ρ(R̂)/τ``.  For a residual that
+    follows ``g_{k+1} = R g_k`` this is ``−ln ρ(R)/τ`` exactly, whatever the window, the
+    modes' mix or a repeated eigenvalue's polynomial prefactor, where a fit of the norm's
+    envelope over a short transient is biased.  The pairs must span a decade
+    (``MIN_DECADES``) above the cut; a member whose envelope was found not decaying or
+    that stopped keeps that reason, and one whose map is singular or has ``ρ ≥ 1`` keeps
+    the envelope's result."""
+    out = meas[row]
+    if S.shape[2] == 0 or out[C_REASON] == R_STOPPED or out[C_REASON] == R_NOT_DECAYING:
+        return
+    floor = out[C_D4]
+    still = (out[C_D2] > out[C_D3] > out[C_D4]
+             and out[C_D2] >= MAP_STILL_DECAYING * out[C_D4])  # fmt: skip
+    top = -1
+    for b in range(NBINS - 1, -1, -1):
+        if lt[j, b] >= 0.0:
+            top = b
+            break
+    per_decade = LEVELS_PER_OCTAVE * math.log2(10.0) * MIN_DECADES
+    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN):
+        if margin < 0.0:  # still decaying: the last fifth's largest norm is no floor
+            if not still:
+                continue
+            cut = 0
+        elif floor > 0.0:
+            cut = ladder_level(margin * floor, base_j) + 1
+        else:
+            cut = 0
+        if top - cut < per_decade:
+            continue
+        first = (cut + (1 << MAP_SHIFT) - 1) >> MAP_SHIFT  # bins wholly above the cut
+        rho, pairs = _pooled_radius(S, j, first) if pm >= 0 else _map_radius(S, j, ng, first)
+        if not (rho < 1.0 and rho > 0.0):
+            return
+        beta = -math.log(rho) / tau
+        n = records(lt, lv, j, rt, ry)
+        edge = (first << MAP_SHIFT) + base_j  # the level, as float bits, of the cut
+        gamma = 0.0
+        t_end = 0.0
+        for i in range(n):
+            if (float_bits(math.exp(ry[i])) >> _SHIFT) >= edge:
+                gamma = max(gamma, math.exp(ry[i] + beta * rt[i]))
+                t_end = rt[i]
+        out[C_BETA] = beta
+        out[C_GAMMA] = gamma
+        out[C_FIT_START] = 0.0
+        out[C_FIT_END] = t_end
+        out[C_POINTS] = pairs
+        out[C_KIND] = K_MAP
+        out[C_SHIFT] = math.nan
+        out[C_REASON] = R_FITTED
+        return
 
 
 @njit(cache=True)

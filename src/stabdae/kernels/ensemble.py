@@ -56,7 +56,20 @@ from numba import njit
 
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
-from .decay import begin, finish, ladders, observe, predict, scratch
+from .decay import (
+    begin,
+    finish,
+    ladder_level,
+    ladders,
+    map_begin,
+    map_buffers,
+    map_estimate,
+    map_observe,
+    observe,
+    predict,
+    scratch,
+    spectral_radius_of,
+)
 from .fma import fma
 from .rhs import kernels_for
 from .source import exec_source
@@ -89,7 +102,7 @@ def _member_step_source(pattern) -> str:
     out, the zero terms of ``pattern`` left out and the factors equal to one dropped.
     It returns the worst status of its right-hand sides, ``‖g‖∞`` and ``‖g − gref‖∞`` at
     the step's start (read from the first stage's evaluation, for the decay measurement at
-    every step); the
+    every step), and leaves ``g − gref`` in ``dv``; the
     new state's finiteness is left to the kernel's checks (a non-finite state stays
     non-finite).
 
@@ -122,7 +135,7 @@ def _member_step_source(pattern) -> str:
         return e or "-0.0"
 
     lines = ["def member_step(t, xk, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, xs, xn,",
-             "                gref):"]
+             "                gref, dv):"]
     lines += [f"    k{s} = stack1(N2)" for s in range(stages)]
     for s in range(stages):
         arg = "xk"
@@ -135,7 +148,8 @@ def _member_step_source(pattern) -> str:
         if s == 0:  # ‖g(x_k)‖∞ and ‖g(x_k) − g_ref‖∞: the first stage has just evaluated g
             lines += ["    gnorm = 0.0", "    dnorm = 0.0", "    for l in range(NG):",
                       "        gnorm = max(gnorm, abs(ws.g[l]))",
-                      "        dnorm = max(dnorm, abs(ws.g[l] - gref[l]))"]
+                      "        dv[l] = ws.g[l] - gref[l]",
+                      "        dnorm = max(dnorm, abs(dv[l]))"]
     lines += [
         "    for l in range(N2):",
         f"        xn[l] = fma(tau, {weights()}, xk[l])",
@@ -255,15 +269,18 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
 
     @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
-                   tab_b, tab_c, threshold, g_ref, R, trace_row, out_norm, meas, x_final,
-                   status, fail_step, e0, e1, b_lo, b_hi):  # fmt: skip
+                   tab_b, tab_c, threshold, g_ref, R, pooled, trace_row, out_norm, meas,
+                   x_final, status, fail_step, e0, e1, b_lo, b_hi):  # fmt: skip
         """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
         :func:`stabdae.ensemble`.  Member ``i``'s stored samples go to row
         ``trace_row[i]`` of ``out_norm`` (none when −1); its decay measures
         (:mod:`.decay`, from ``‖g‖`` at every step) to row ``i`` of ``meas``, with the
         linear prediction ``g_{k+1} = R g_k`` from ``alpha0s[i]`` when ``R`` is not
-        empty.  The decay is measured on ``‖g_k − g_ref[k]‖∞``, ``g_ref`` the residual of a
-        reference trajectory at every step (none when it has no rows: ``‖g_k‖∞``).
+        empty, and its one-step map pooled over the constraints when ``pooled`` (the
+        number of holonomic constraints; −1: the law is not alike on every constraint)
+        is not negative (:func:`.decay.map_buffers`).  The decay is measured on
+        ``‖g_k − g_ref[k]‖∞``, ``g_ref`` the residual of a reference trajectory at every
+        step (none when it has no rows: ``‖g_k‖∞``).
         Every output row of the blocks is written here (``out_norm`` NaN after a stop,
         ``status`` 0 and ``fail_step`` −1 for a member that runs to the end), so the
         driver allocates them empty and the pages are first touched by the threads
@@ -308,6 +325,10 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             gr[l] = 0.0
         lt, lv, base = ladders(B)  # the decay measurement's ladder per slot
         rt, ry, fa, fb, lg = scratch()
+        # the one-step map's sums per slot, fed from each step's g − g_ref (Dv)
+        S_map, prev_map, lev_map, upto_map = map_buffers(B, ng, pooled)
+        Dv = stack2(ng, B)
+        rho_R = spectral_radius_of(R) if R.shape[0] > 0 else math.nan
         g_p = np.empty(alpha0s.shape[1])
         gn_p = np.empty(alpha0s.shape[1])
         for b in range(b_lo, b_hi):
@@ -339,6 +360,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 if trace_row[lo + j] >= 0:
                     out_norm[trace_row[lo + j], 0] = nrm
                 begin(lt, lv, base, meas, j, lo + j, nrm, dn_b[j])
+                map_begin(S_map, upto_map, j)
                 active[j] = True
                 alive += 1
                 if not (nrm <= threshold):
@@ -368,11 +390,15 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     xk = stack1(N2)
                     xs = stack1(N2)
                     xn = stack1(N2)
+                    dv = stack1(ng)
                     for l in range(N2):
                         xk[l] = X[l, j]
-                    c, gn, dn = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn, gr)
+                    c, gn, dn = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn, gr,
+                                            dv)  # fmt: skip
                     for l in range(N2):
                         X[l, j] = xn[l]
+                    for l in range(ng):
+                        Dv[l, j] = dv[l]
                     code[j] |= c
                     gn_b[j] = gn
                     dn_b[j] = dn
@@ -384,6 +410,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     if active[j]:
                         observe(lt, lv, base, meas, j, lo + j, (i - 1) * tau, gn_b[j],
                                 dn_b[j], window)  # fmt: skip
+                        map_observe(S_map, prev_map, lev_map, upto_map, j, i - 1, Dv,
+                                    ladder_level(dn_b[j], base[j]), pooled)  # fmt: skip
                 until_save -= 1
                 renew = True
                 if i <= careful_to:  # stop the members whose step failed; Xc: the step before
@@ -440,9 +468,10 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
                 finish(lt, lv, meas, j, lo + j, final, not active[j], tau, rt, ry, fa, fb, lg)
+                map_estimate(S_map, j, ng, pooled, lt, lv, base[j], meas, lo + j, tau, rt, ry)
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps, tau, lt, lv, base, meas, j, lo + j,
-                            rt, ry, fa, fb, lg, g_p, gn_p)  # fmt: skip
+                            rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
     tag(key, block_norms, retire, stop_failed, block_failed, member_step)
