@@ -232,6 +232,7 @@ class Baseline:
 
 
 def main(argv=None) -> dict:
+    global T_END, NSTEPS  # the run length, set per configuration
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--members", type=int, nargs="+", default=[10_000, 100_000])
     parser.add_argument("--numpy-members", type=int, default=10_000,
@@ -246,7 +247,6 @@ def main(argv=None) -> dict:
                              "a second process), alternating with this one")  # fmt: skip
     parser.add_argument("--out", default=str(HERE / "results"))
     args = parser.parse_args(argv)
-    global T_END, NSTEPS
 
     # before libgomp is loaded (build_c): its workers must not spin after a C run
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
@@ -275,7 +275,7 @@ def main(argv=None) -> dict:
     baseline = Baseline(args.baseline) if args.baseline else None
     if baseline:
         report["baseline_rev"] = baseline.rev
-        baseline.run(ds.x0.values, 10 * TAU)  # its compilation, outside the timings
+        baseline.run(ds.x0.values, SAVE_DT)  # its compilation, outside the timings
     configs = [(t, M) for t in args.t_end for M in args.members]
     for T_END, M in configs:
         NSTEPS = round(T_END / TAU)
