@@ -231,51 +231,9 @@ class Baseline:
                         str(self.dir / "tree")], check=False, capture_output=True)  # fmt: skip
 
 
-def main(argv=None) -> dict:
+def _runs(args, model, law, lib, lib_ieee, baseline, report):
+    """Every configuration (run length × members), each variant timed in turn."""
     global T_END, NSTEPS  # the run length, set per configuration
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--members", type=int, nargs="+", default=[10_000, 100_000])
-    parser.add_argument("--numpy-members", type=int, default=10_000,
-                        help="NumPy is slow: run it at this size only")  # fmt: skip
-    parser.add_argument("--repeat", type=int, default=3,
-                        help="runs of the API, kernel and blocked C variants (best kept)")
-    parser.add_argument("--t-end", type=float, nargs="+", default=[T_END],
-                        help="run lengths (s); 2 s: runs short enough that what the API does "
-                             "besides integrating shows")  # fmt: skip
-    parser.add_argument("--baseline", metavar="REV",
-                        help="also time stabdae.ensemble of this git revision (a worktree, "
-                             "a second process), alternating with this one")  # fmt: skip
-    parser.add_argument("--out", default=str(HERE / "results"))
-    args = parser.parse_args(argv)
-
-    # before libgomp is loaded (build_c): its workers must not spin after a C run
-    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
-    # compile time from a cold, private kernel cache; then a second process on that cache
-    os.environ["STABDAE_CACHE_DIR"] = tempfile.mkdtemp(prefix="stabdae-bench-cache-")
-    model = stabdae.load_model("pendulum")
-    law = stabdae.baumgarte(OMEGA, XI)
-    start = time.perf_counter()
-    ds = stabdae.ensemble(model, law, "midpoint", TAU, 10 * TAU, members=8, save_dt=TAU)
-    compile_s = time.perf_counter() - start
-    stabdae.ensemble(model, law, "midpoint", TAU, 10 * TAU, x0=ds.x0.values, save_dt=TAU)
-    warm_s = second_process_start()
-    lib = build_c()
-    # gcc contracts every a*b + c into an FMA by default; stabdae fuses only its own sums
-    # (no fastmath), so the build without contraction is reported beside it
-    lib_ieee = build_c("-ffp-contract=off")
-    report = {"machine": platform.processor() or platform.machine(),
-              "threads": numba.get_num_threads(), "stabdae_compile_s": compile_s,
-              "omp_wait_policy": os.environ["OMP_WAIT_POLICY"],
-              "config": dict(tau=TAU, t_end=T_END, save_dt=SAVE_DT, omega=OMEGA, xi=XI),
-              "runs": []}  # fmt: skip
-    report["stabdae_second_process_s"] = warm_s
-    print(f"stabdae compile (first call of a new model, tiny ensemble): {compile_s:.2f} s; "
-          f"a second process, import to first ensemble done: {warm_s:.2f} s; "
-          f"threads: {report['threads']}")
-    baseline = Baseline(args.baseline) if args.baseline else None
-    if baseline:
-        report["baseline_rev"] = baseline.rev
-        baseline.run(ds.x0.values, SAVE_DT)  # its compilation, outside the timings
     configs = [(t, M) for t in args.t_end for M in args.members]
     for T_END, M in configs:
         NSTEPS = round(T_END / TAU)
@@ -337,8 +295,57 @@ def main(argv=None) -> dict:
         if baseline:
             print(f"this revision's API over {baseline.rev[:10]}'s: {t_base / api:.3f} "
                   f"(same final states: {row['baseline_same_final_states']})")
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--members", type=int, nargs="+", default=[10_000, 100_000])
+    parser.add_argument("--numpy-members", type=int, default=10_000,
+                        help="NumPy is slow: run it at this size only")  # fmt: skip
+    parser.add_argument("--repeat", type=int, default=3,
+                        help="runs of the API, kernel and blocked C variants (best kept)")
+    parser.add_argument("--t-end", type=float, nargs="+", default=[T_END],
+                        help="run lengths (s); 2 s: runs short enough that what the API does "
+                             "besides integrating shows")  # fmt: skip
+    parser.add_argument("--baseline", metavar="REV",
+                        help="also time stabdae.ensemble of this git revision (a worktree, "
+                             "a second process), alternating with this one")  # fmt: skip
+    parser.add_argument("--out", default=str(HERE / "results"))
+    args = parser.parse_args(argv)
+
+    # before libgomp is loaded (build_c): its workers must not spin after a C run
+    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+    # compile time from a cold, private kernel cache; then a second process on that cache
+    os.environ["STABDAE_CACHE_DIR"] = tempfile.mkdtemp(prefix="stabdae-bench-cache-")
+    model = stabdae.load_model("pendulum")
+    law = stabdae.baumgarte(OMEGA, XI)
+    start = time.perf_counter()
+    ds = stabdae.ensemble(model, law, "midpoint", TAU, 10 * TAU, members=8, save_dt=TAU)
+    compile_s = time.perf_counter() - start
+    stabdae.ensemble(model, law, "midpoint", TAU, 10 * TAU, x0=ds.x0.values, save_dt=TAU)
+    warm_s = second_process_start()
+    lib = build_c()
+    # gcc contracts every a*b + c into an FMA by default; stabdae fuses only its own sums
+    # (no fastmath), so the build without contraction is reported beside it
+    lib_ieee = build_c("-ffp-contract=off")
+    report = {"machine": platform.processor() or platform.machine(),
+              "threads": numba.get_num_threads(), "stabdae_compile_s": compile_s,
+              "omp_wait_policy": os.environ["OMP_WAIT_POLICY"],
+              "config": dict(tau=TAU, t_end=T_END, save_dt=SAVE_DT, omega=OMEGA, xi=XI),
+              "runs": []}  # fmt: skip
+    report["stabdae_second_process_s"] = warm_s
+    print(f"stabdae compile (first call of a new model, tiny ensemble): {compile_s:.2f} s; "
+          f"a second process, import to first ensemble done: {warm_s:.2f} s; "
+          f"threads: {report['threads']}")
+    baseline = Baseline(args.baseline) if args.baseline else None
     if baseline:
-        baseline.close()
+        report["baseline_rev"] = baseline.rev
+        baseline.run(ds.x0.values, SAVE_DT)  # its compilation, outside the timings
+    try:
+        _runs(args, model, law, lib, lib_ieee, baseline, report)
+    finally:  # the worktree goes even when a run fails
+        if baseline:
+            baseline.close()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "bench_throughput.json").write_text(json.dumps(report, indent=2))

@@ -701,6 +701,26 @@ def _cluster_radius(moduli, n):
 
 
 @njit(cache=True)
+def _radius2(r00, r01, r10, r11):
+    """:func:`spectral_radius_of` of the 2 × 2 matrix ``[[r00, r01], [r10, r11]]`` in
+    closed form, without arrays (NaN for non-finite entries)."""
+    half = 0.5 * (r00 + r11)
+    det = r00 * r11 - r01 * r10
+    disc = half * half - det
+    if disc < 0.0:
+        return math.sqrt(det)
+    big = abs(half + math.sqrt(disc))
+    small = abs(half - math.sqrt(disc))
+    if big < small:
+        big, small = small, big
+    if not (big > 0.0) or big == math.inf or not (small > 0.0):
+        return big
+    if math.log(big / small) <= CLUSTER * abs(math.log(big)):  # as _cluster_radius
+        return math.sqrt(big * small)
+    return big
+
+
+@njit(cache=True)
 def spectral_radius_of(R):
     """``ρ(R)`` of a small real matrix (closed form up to 2 × 2), where eigenvalues of
     nearly the same modulus count as one repeated eigenvalue (:func:`_cluster_radius`):
@@ -708,22 +728,15 @@ def spectral_radius_of(R):
     n = R.shape[0]
     if n == 1:
         return abs(R[0, 0])
-    moduli = np.empty(n)
-    if n == 2:  # (NaN for non-finite entries, like the eigenvalues below)
-        half = 0.5 * (R[0, 0] + R[1, 1])
-        det = R[0, 0] * R[1, 1] - R[0, 1] * R[1, 0]
-        disc = half * half - det
-        if disc < 0.0:
-            return math.sqrt(det)
-        moduli[0] = abs(half + math.sqrt(disc))
-        moduli[1] = abs(half - math.sqrt(disc))
-        return _cluster_radius(moduli, 2)
+    if n == 2:
+        return _radius2(R[0, 0], R[0, 1], R[1, 0], R[1, 1])
     for i in range(n):
         for q in range(n):
             if not math.isfinite(R[i, q]):
                 return math.nan
     # complex input: numba's real eigvals refuses complex eigenvalues
     lam = np.linalg.eigvals(R.astype(np.complex128))
+    moduli = np.empty(n)
     for i in range(n):
         moduli[i] = abs(lam[i])
     return _cluster_radius(moduli, n)
@@ -740,13 +753,9 @@ def _pooled_radius(S, j, first):
             s[c] += S[j, b, c]
     rho = -1.0
     det = s[0] * s[3] - s[1] * s[2]
-    if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:
-        R = np.empty((2, 2))  # S1 S0⁻¹
-        R[0, 0] = (s[4] * s[3] - s[5] * s[2]) / det
-        R[0, 1] = (s[5] * s[0] - s[4] * s[1]) / det
-        R[1, 0] = (s[6] * s[3] - s[7] * s[2]) / det
-        R[1, 1] = (s[7] * s[0] - s[6] * s[1]) / det
-        rho = spectral_radius_of(R)
+    if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:  # S1 S0⁻¹
+        rho = _radius2((s[4] * s[3] - s[5] * s[2]) / det, (s[5] * s[0] - s[4] * s[1]) / det,
+                       (s[6] * s[3] - s[7] * s[2]) / det, (s[7] * s[0] - s[6] * s[1]) / det)
     if s[8] > 0.0:
         rho = max(rho, abs(s[9] / s[8]))
     return (rho if rho >= 0.0 else math.nan), s[10]
