@@ -643,3 +643,41 @@ def test_one_step_map_gives_the_discrete_rate_of_a_short_transient(scheme, xi):
     np.testing.assert_allclose(ds.beta.values, predicted, rtol=1e-4)
     np.testing.assert_allclose(ds.beta_ratio.values, 1.0, rtol=1e-4)
     assert set(ds.fit_kind.values.tolist()) == {decay.K_MAP}
+
+
+def test_measurement_stride_changes_no_rate(monkeypatch):
+    """The fixed-step kernel measures every s-th step, s from the law's one-step map (ω = 10,
+    ξ = 1, midpoint, τ = 1e-3: |ln λ| = 0.01 per step, s = 10; a law ten times faster
+    gets s = 1; not constant: 1).  β from pairs a stride apart is that of every step to
+    1e-5 (the map fitted to them is R^s, whose radius is ρ(R)^s), the floor and the
+    largest norm within the stride's resolution (a tenth in ln: 0.5 % at a maximum), γ
+    within 2 %."""
+    from stabdae import _ensemble
+    from stabdae._schemes import as_scheme
+    from stabdae.theory import step_matrix
+
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10, 1)
+    A = law.A_tilde(model)
+    mid = as_scheme("midpoint")
+    assert _ensemble.measure_stride(step_matrix(A, mid, 1e-3)) == 10
+    assert _ensemble.measure_stride(step_matrix(10 * A, mid, 1e-3)) == 1
+    assert _ensemble.measure_stride(step_matrix(A, mid, 1e-5)) == _ensemble.MAX_STRIDE
+    assert _ensemble.measure_stride(np.zeros((0, 0))) == 1
+
+    run = lambda: stabdae.ensemble(model, law, "midpoint", 1e-3, 3.0, members=64,  # noqa: E731
+                                   radius=(1e-6, 1e-2), seed=5, traces="none")  # fmt: skip
+    strided = run()
+    monkeypatch.setattr(_ensemble, "measure_stride", lambda R: 1)
+    every = run()
+    assert strided.attrs["measure_every"] == 10 and every.attrs["measure_every"] == 1
+    assert int(every.members_with_beta) == int(strided.members_with_beta) == 64
+    np.testing.assert_allclose(strided.beta.values, every.beta.values, rtol=1e-5)
+    # γ: the largest ‖g‖e^{βt} on the transient, for a Jordan block |c0 + c1 t| at the
+    # transient's end, which a stride moves by up to one stride (1 % of the window here)
+    np.testing.assert_allclose(strided.gamma.values, every.gamma.values, rtol=0.02)
+    for name in ("residual_floor", "max_residual"):
+        np.testing.assert_allclose(strided[name].values, every[name].values, rtol=0.005,
+                                   err_msg=name)  # fmt: skip
+    for name in ("residual_floor", "max_residual"):  # maxima over a subset of the states
+        assert (strided[name].values <= every[name].values).all(), name

@@ -2,8 +2,10 @@
 
 A member's ``‖g‖∞`` first decays at the rate of the law (continuous: ``−max Re λ(Ã)``;
 discrete: ``−ln ρ(R(τÃ))/τ``) and then settles on a floor set by the scheme's local error
-(the paper's §5).  The kernels measure it at every step, not on the stored samples, with
-O(1) work per step and a fixed amount of memory per member (a *ladder*):
+(the paper's §5).  The kernels measure it where the step evaluates the residual, not on
+the stored samples (the fixed-step kernel every ``s``-th step, over which no mode of the
+law changes by more than a tenth: :func:`stabdae._ensemble.measure_stride`), with O(1)
+work per step and a fixed amount of memory per member (a *ladder*):
 
 * the norm's level on a log scale of ``LEVELS_PER_OCTAVE`` levels per octave (read from
   the float's exponent and leading mantissa bits: no logarithm per step), over
@@ -56,9 +58,11 @@ import struct
 import numpy as np
 from llvmlite import ir
 from numba import config, njit, types
+from numba.cpython.unsafe.numbers import trailing_zeros as _numba_trailing_zeros
 from numba.extending import intrinsic
 
 from .threads import run_chunks
+from .workspace import stack1
 
 #: levels of the ladder per octave (the leading mantissa bits read: 3)
 LEVELS_PER_OCTAVE = 8
@@ -532,6 +536,24 @@ def begin(lt, lv, base, meas, j, row, g0, d0):
 def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
     """Member ``row``'s measures from ladder row ``j`` at the end of its run (``final``:
     the norm at its last state; ``stopped``: it did not run to the end)."""
+    still = summarize(meas, row, final, stopped)
+    if not stopped:
+        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+
+
+@njit(cache=True)
+def fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg):
+    """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
+    ``still``: the run ended while it was decaying)."""
+    n = records(lt, lv, j, rt, ry)
+    estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row])
+
+
+@njit(cache=True)
+def summarize(meas, row, final, stopped):
+    """Member ``row``'s columns other than the fit at the end of its run (``final``: the
+    norm at its last state; ``stopped``: it did not run to the end; then the fit's
+    columns say so).  Returns whether the measured norm was still decaying at the end."""
     out = meas[row]
     out[C_FINAL] = final
     largest = -math.inf
@@ -542,8 +564,7 @@ def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
             largest = max(largest, out[C_W0 + w])
     out[C_LARGEST] = largest if largest > -math.inf else math.nan
     out[C_FLOOR] = out[C_W4]
-    # the measured norm's own floor and whether it is still falling at the end
-    floor = out[C_D4]
+    # whether the measured norm is still falling at the end
     still = (out[C_D2] >= STILL_DECAYING * out[C_D3]
              and out[C_D3] >= STILL_DECAYING * out[C_D4])  # fmt: skip
     out[C_FLOOR_REACHED] = 0.0 if still else 1.0
@@ -553,9 +574,7 @@ def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
         out[C_POINTS] = 0
         out[C_KIND] = K_NONE
         out[C_REASON] = R_STOPPED
-        return
-    n = records(lt, lv, j, rt, ry)
-    estimate(rt, ry, n, floor, still, dt, a, b, lg, out)
+    return still
 
 
 @njit(cache=True)
@@ -605,78 +624,233 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g
 # --------------------------------------------------------------------- one-step map
 @njit(cache=True)
 def map_buffers(rows, ng, pm):
-    """The one-step map's buffers for ``rows`` members at a time: per member and bin the
-    sums of the pairs' outer products and their number; each member's previous ``g``,
-    its ladder level and the last step whose pair was added.
+    """The one-step map's sums for ``rows`` members at a time: per member and bin the
+    sums of the pairs' outer products and their number (:func:`map_width` columns)."""
+    return np.zeros((rows, MAP_BINS, map_width(ng, pm)))
+
+
+@njit(cache=True)
+def map_width(ng, pm):
+    """The one-step map's sums per bin.
 
     With ``pm ≥ 0`` the law acts alike on each of the ``pm`` holonomic constraints (one
     2 × 2 block on every ``(f_i, ḟ_i)``) and on each nonholonomic one (one number on
     every ``h_j``): the pairs of all constraints are pooled into one 2 × 2 and one 1 × 1
     fit (11 sums).  Otherwise the full ``ng × ng`` map is fitted (``2 ng² + 1`` sums),
-    for residuals of at most ``MAP_MAX_NG`` components (none above: no bins)."""
+    for residuals of at most ``MAP_MAX_NG`` components (none above)."""
     if pm >= 0:
-        width = 11
-    else:
-        width = 2 * ng * ng + 1 if ng <= MAP_MAX_NG else 0
-    S = np.zeros((rows, MAP_BINS if width else 0, width))
-    prev = np.zeros((rows, ng))
-    plev = np.zeros(rows, dtype=np.int64)
-    upto = np.zeros(rows, dtype=np.int64)
-    return S, prev, plev, upto
+        return 11
+    return 2 * ng * ng + 1 if ng <= MAP_MAX_NG else 0
 
 
 @njit(cache=True)
-def map_begin(S, upto, j):
+def map_begin(S, j):
     """Clear slot ``j``'s sums for a new member."""
     for b in range(S.shape[1]):
         for c in range(S.shape[2]):
             S[j, b, c] = 0.0
-    upto[j] = 0
 
 
-@njit(cache=True)
-def map_observe(S, prev, plev, upto, j, k, D, level, pm):
-    """State ``k``'s residual ``D[:, j]`` (its norm at ladder ``level``) of slot ``j``:
-    the pair (state k − 1, state k) is added to the bin of the earlier state's level,
-    once (steps done again after a rollback bring the same pairs: they are not added
-    twice, so the sums do not depend on the block's other members).  ``pm``: as in
-    :func:`map_buffers`."""
-    ng = prev.shape[1]
-    if k >= 1 and k > upto[j] and S.shape[2] > 0:
-        b = plev[j] >> MAP_SHIFT
-        if pm >= 0:  # pooled: Σ p pᵀ, Σ p' pᵀ over p = (f_i, ḟ_i); Σ h², Σ h' h
-            for i in range(pm):
-                a0, a1 = prev[j, i], prev[j, pm + i]
-                c0, c1 = D[i, j], D[pm + i, j]
-                S[j, b, 0] += a0 * a0
-                S[j, b, 1] += a0 * a1
-                S[j, b, 2] += a1 * a0
-                S[j, b, 3] += a1 * a1
-                S[j, b, 4] += c0 * a0
-                S[j, b, 5] += c0 * a1
-                S[j, b, 6] += c1 * a0
-                S[j, b, 7] += c1 * a1
-            for i in range(2 * pm, ng):
-                S[j, b, 8] += prev[j, i] * prev[j, i]
-                S[j, b, 9] += D[i, j] * prev[j, i]
-            S[j, b, 10] += 1.0
-        else:
+def _trailing_zeros_python(x):
+    return (int(x) & -int(x)).bit_length() - 1
+
+
+trailing_zeros = _trailing_zeros_python if config.DISABLE_JIT else _numba_trailing_zeros
+trailing_zeros.__doc__ = """The index of the lowest set bit of a non-zero int64."""
+
+
+def block_measures(B: int, ng: int, pm: int):
+    """The decay measurement of a block of ``B`` members in lockstep, for a residual of
+    ``ng`` components, the first ``2 pm`` of them ``(f, ḟ)`` (``pm`` the model's number
+    of holonomic constraints).
+
+    What :func:`observe` and the one-step map's sums do member by member, here for the
+    whole block at once, in loops over its members (structure of arrays, member index
+    innermost: they vectorize), with the scattered writes deferred:
+
+    * the ladder: each member's level (``levels``, vectorized), then the time and norm
+      written on it (``record``, a scatter);
+    * the one-step map: the pairs' sums of the current bin visit in ``A`` (a row per sum,
+      the symmetric ``Σ p pᵀ`` once), added to the member's bin when its level leaves
+      it (``bin_flush``: a scalar loop over the members whose bit is set in the mask
+      ``levels`` returns);
+    * the largest norms of the current fifth of the run in ``wmax`` and ``dmax``, written
+      to the member's row when the fifth ends or the member stops (``windows_flush``).
+
+    The ladder is :func:`observe`'s; the map's sums are added per visit of a bin, then
+    into the bin.  Returns ``(norms, pairs_pooled, pairs_full, levels, record, bin_flush,
+    end_flush, windows_flush, rows_full)``, ``rows_full`` the rows of the full map's ``A`` (1 when
+    ``ng > MAP_MAX_NG``: no full map)."""
+    PM, NH = pm, ng - 2 * pm
+    FULL = ng if ng <= MAP_MAX_NG else 0
+    ROWS_FULL = FULL * (FULL + 1) // 2 + FULL * FULL + 1 if FULL else 1
+    LAST = NBINS - 1
+
+    @njit(forceinline=True, error_model="numpy")
+    def norms(Dv, gr, gn, dn):
+        """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
+        norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
+        for j in range(B):
+            gn[j] = 0.0
+            dn[j] = 0.0
+        for l in range(ng):
+            r = gr[l]
+            for j in range(B):
+                g = Dv[l, j]
+                d = g - r
+                Dv[l, j] = d
+                gn[j] = max(gn[j], abs(g))
+                dn[j] = max(dn[j], abs(d))
+
+    @njit(forceinline=True, error_model="numpy")
+    def pairs_pooled(Dv, P, A, w):
+        """The pairs (``P``: the previous measured residuals, ``Dv``: the current) added
+        with weight ``w`` (0: no previous one yet) to the pooled sums (10 rows: Σ p pᵀ's
+        3, Σ p' pᵀ's 4 over ``p = (f_i, ḟ_i)``, Σ h², Σ h' h, the count); then
+        ``P = Dv``."""
+        for i in range(PM):
+            for j in range(B):
+                a0 = P[i, j]
+                a1 = P[PM + i, j]
+                c0 = Dv[i, j]
+                c1 = Dv[PM + i, j]
+                A[0, j] += w * (a0 * a0)
+                A[1, j] += w * (a0 * a1)
+                A[2, j] += w * (a1 * a1)
+                A[3, j] += w * (c0 * a0)
+                A[4, j] += w * (c0 * a1)
+                A[5, j] += w * (c1 * a0)
+                A[6, j] += w * (c1 * a1)
+        for i in range(2 * PM, 2 * PM + NH):
+            for j in range(B):
+                A[7, j] += w * (P[i, j] * P[i, j])
+                A[8, j] += w * (Dv[i, j] * P[i, j])
+        for j in range(B):
+            A[9, j] += w
+        for l in range(ng):
+            for j in range(B):
+                P[l, j] = Dv[l, j]
+
+    @njit(forceinline=True, error_model="numpy")
+    def pairs_full(Dv, P, A, w):
+        """As ``pairs_pooled`` for the full map: Σ p pᵀ (upper triangle), Σ p' pᵀ, the
+        count."""
+        c = 0
+        for r in range(FULL):
+            for q in range(r, FULL):
+                for j in range(B):
+                    A[c, j] += w * (P[r, j] * P[q, j])
+                c += 1
+        for r in range(FULL):
+            for q in range(FULL):
+                for j in range(B):
+                    A[c, j] += w * (Dv[r, j] * P[q, j])
+                c += 1
+        for j in range(B):
+            A[ROWS_FULL - 1, j] += w
+        for l in range(ng):
+            for j in range(B):
+                P[l, j] = Dv[l, j]
+
+    @njit(forceinline=True, error_model="numpy")
+    def levels(gn, dn, base, lev, nlev, wmax, dmax):
+        """The block's norms ``gn`` (of ``g``) and ``dn`` (measured) at a state: the
+        largest of the fifth, each slot's ladder level into ``nlev`` (``NBINS``, the
+        ladder's spare column, for a non-finite norm, which :func:`observe` leaves out);
+        returns a mask of the slots whose level left the map's bin of ``lev``, the
+        previous state's levels."""
+        changed = 0
+        for j in range(B):
+            v = gn[j]
+            wm = wmax[j]
+            wmax[j] = v if (v < math.inf and not (wm >= v)) else wm
+            d = dn[j]
+            ok = d < math.inf
+            dm = dmax[j]
+            dmax[j] = d if (ok and not (dm >= d)) else dm
+            b = min(max((float_bits(d) >> _SHIFT) - base[j], 0), LAST)
+            nlev[j] = b if ok else NBINS
+            moved = ok and (b >> MAP_SHIFT) != (lev[j] >> MAP_SHIFT)
+            changed |= (1 if moved else 0) << j
+        return changed
+
+    @njit(forceinline=True)
+    def record(lt, lv, dn, lev, nlev, t):
+        """Time ``t`` and norm on each slot's level (a scatter, apart from the vectorized
+        loops); then the levels are the previous state's."""
+        for j in range(B):
+            b = nlev[j]
+            lt[j, b] = t
+            lv[j, b] = dn[j]
+            if b < NBINS:
+                lev[j] = b
+
+    @njit(forceinline=True)
+    def _move(S, A, j, bin_, pooled):
+        """Slot ``j``'s sums of the current bin visit into its bin ``bin_``."""
+        if pooled >= 0:
+            S[j, bin_, 0] += A[0, j]
+            S[j, bin_, 1] += A[1, j]
+            S[j, bin_, 2] += A[1, j]
+            S[j, bin_, 3] += A[2, j]
+            for c in range(4):
+                S[j, bin_, 4 + c] += A[3 + c, j]
+            S[j, bin_, 8] += A[7, j]
+            S[j, bin_, 9] += A[8, j]
+            S[j, bin_, 10] += A[9, j]
+            for c in range(10):
+                A[c, j] = 0.0
+        elif FULL:
             c = 0
-            for r in range(ng):
-                pr = prev[j, r]
-                for q in range(ng):
-                    S[j, b, c] += pr * prev[j, q]
+            for r in range(FULL):
+                for q in range(r, FULL):
+                    S[j, bin_, r * FULL + q] += A[c, j]
+                    if q != r:
+                        S[j, bin_, q * FULL + r] += A[c, j]
                     c += 1
-            for r in range(ng):
-                dr = D[r, j]
-                for q in range(ng):
-                    S[j, b, c] += dr * prev[j, q]
-                    c += 1
-            S[j, b, c] += 1.0
-        upto[j] = k
-    for r in range(ng):
-        prev[j, r] = D[r, j]
-    plev[j] = level
+            for r in range(FULL * FULL):
+                S[j, bin_, FULL * FULL + r] += A[c, j]
+                c += 1
+            S[j, bin_, 2 * FULL * FULL] += A[c, j]
+            for c in range(ROWS_FULL):
+                A[c, j] = 0.0
+
+    @njit(error_model="numpy")
+    def bin_flush(S, A, lev, mask, pooled):
+        """The slots of the set bits of ``mask``, whose level left the map's bin of the
+        previous state: that visit's sums into that bin."""
+        while mask != 0:
+            j = trailing_zeros(mask)
+            mask &= mask - 1
+            _move(S, A, j, lev[j] >> MAP_SHIFT, pooled)
+
+    @njit(error_model="numpy")
+    def end_flush(S, A, lev, active, pooled):
+        """At the end of the run: each running slot's current bin visit's sums."""
+        for j in range(B):
+            if active[j]:
+                _move(S, A, j, lev[j] >> MAP_SHIFT, pooled)
+
+    @njit(error_model="numpy")
+    def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
+        """The largest norms of fifth ``window`` so far to the rows of the running
+        members; then cleared."""
+        for j in range(cnt):
+            if active[j]:
+                row = lo + j
+                c = C_W0 + window
+                if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
+                    meas[row, c] = wmax[j]
+                if window >= 2:
+                    c = C_D2 + window - 2
+                    if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
+                        meas[row, c] = dmax[j]
+        for j in range(B):
+            wmax[j] = -math.inf
+            dmax[j] = -math.inf
+
+    return (norms, pairs_pooled, pairs_full, levels, record, bin_flush, end_flush,
+            windows_flush, ROWS_FULL)
 
 
 @njit(cache=True)
@@ -747,7 +921,9 @@ def _pooled_radius(S, j, first):
     """``ρ`` of the pooled fits (:func:`map_buffers`): the larger of the 2 × 2 map of
     the ``(f_i, ḟ_i)`` pairs and the 1 × 1 map of the ``h_j``, each where it has data;
     the number of pairs."""
-    s = np.zeros(11)
+    s = stack1(11)
+    for c in range(11):
+        s[c] = 0.0
     for b in range(first, S.shape[1]):
         for c in range(11):
             s[c] += S[j, b, c]
@@ -822,12 +998,12 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry):
     follows ``g_{k+1} = R g_k`` this is ``−ln ρ(R)/τ`` exactly, whatever the window, the
     modes' mix or a repeated eigenvalue's polynomial prefactor, where a fit of the norm's
     envelope over a short transient is biased.  The pairs must span a decade
-    (``MIN_DECADES``) above the cut; a member whose envelope was found not decaying or
-    that stopped keeps that reason, and one whose map is singular or has ``ρ ≥ 1`` keeps
-    the envelope's result."""
+    (``MIN_DECADES``) above the cut; a member without such pairs, or whose map is
+    singular or has ``ρ ≥ 1``, and a growing one (:func:`grows`) are left to the
+    envelope's fit (:func:`fit_envelope`).  Returns whether it gave β."""
     out = meas[row]
-    if S.shape[2] == 0 or out[C_REASON] == R_STOPPED or out[C_REASON] == R_NOT_DECAYING:
-        return
+    if S.shape[2] == 0 or grows(out[C_D2], out[C_D3], out[C_D4]):
+        return False
     floor = out[C_D4]
     still = (out[C_D2] > out[C_D3] > out[C_D4]
              and out[C_D2] >= MAP_STILL_DECAYING * out[C_D4])  # fmt: skip
@@ -851,16 +1027,16 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry):
         first = (cut + (1 << MAP_SHIFT) - 1) >> MAP_SHIFT  # bins wholly above the cut
         rho, pairs = _pooled_radius(S, j, first) if pm >= 0 else _map_radius(S, j, ng, first)
         if not (rho < 1.0 and rho > 0.0):
-            return
+            return False
         beta = -math.log(rho) / tau
-        n = records(lt, lv, j, rt, ry)
-        edge = (first << MAP_SHIFT) + base_j  # the level, as float bits, of the cut
+        # γ over the envelope's points above the cut (:func:`records`, without its logs)
         gamma = 0.0
-        t_end = 0.0
-        for i in range(n):
-            if (float_bits(math.exp(ry[i])) >> _SHIFT) >= edge:
-                gamma = max(gamma, math.exp(ry[i] + beta * rt[i]))
-                t_end = rt[i]
+        t_end = -1.0
+        for b in range(top, (first << MAP_SHIFT) - 1, -1):
+            t = lt[j, b]
+            if t > t_end:
+                t_end = t
+                gamma = max(gamma, lv[j, b] * math.exp(beta * t))
         out[C_BETA] = beta
         out[C_GAMMA] = gamma
         out[C_FIT_START] = 0.0
@@ -869,14 +1045,18 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry):
         out[C_KIND] = K_MAP
         out[C_SHIFT] = math.nan
         out[C_REASON] = R_FITTED
-        return
+        return True
+    return False
 
 
 @njit(cache=True)
 def ladders(rows):
     """Ladder buffers (times, values, offsets) for ``rows`` members at a time."""
-    lt = np.empty((rows, NBINS))
-    lv = np.empty((rows, NBINS))
+    # A spare column for writes to be ignored (``NBINS``), and rows 4096 + 72 bytes
+    # apart: rows a multiple of 4 kB apart share the L1 cache's sets, and the scattered
+    # writes of a block's 64 members evicted each other.
+    lt = np.empty((rows, NBINS + 9))
+    lv = np.empty((rows, NBINS + 9))
     base = np.zeros(rows, dtype=np.int64)
     return lt, lv, base
 

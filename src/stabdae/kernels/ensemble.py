@@ -58,17 +58,19 @@ from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
 from .decay import (
     begin,
-    finish,
+    block_measures,
+    fit_envelope,
+    ladder_base,
     ladder_level,
     ladders,
     map_begin,
     map_buffers,
     map_estimate,
-    map_observe,
     observe,
     predict,
     scratch,
     spectral_radius_of,
+    summarize,
 )
 from .fma import fma
 from .rhs import kernels_for
@@ -100,11 +102,10 @@ def tableau_pattern(scheme) -> tuple:
 def _member_step_source(pattern) -> str:
     """Python source of one member's explicit Runge–Kutta step with the stages written
     out, the zero terms of ``pattern`` left out and the factors equal to one dropped.
-    It returns the worst status of its right-hand sides, ``‖g‖∞`` and ``‖g − gref‖∞`` at
-    the step's start (read from the first stage's evaluation, for the decay measurement at
-    every step), and leaves ``g − gref`` in ``dv``; the
-    new state's finiteness is left to the kernel's checks (a non-finite state stays
-    non-finite).
+    It returns the worst status of its right-hand sides and leaves the residual ``g`` at
+    the step's start in ``gv`` (read from the first stage's evaluation, for the decay
+    measurement); the new state's finiteness is left to the kernel's checks (a non-finite
+    state stays non-finite).
 
     Written out rather than looped, so that the body has no inner loops left around the
     inlined right-hand sides and the member loop around it vectorizes for any number of
@@ -135,7 +136,7 @@ def _member_step_source(pattern) -> str:
         return e or "-0.0"
 
     lines = ["def member_step(t, xk, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, xs, xn,",
-             "                gref, dv):"]
+             "                gv):"]
     lines += [f"    k{s} = stack1(N2)" for s in range(stages)]
     for s in range(stages):
         arg = "xk"
@@ -145,16 +146,13 @@ def _member_step_source(pattern) -> str:
         lines.append(
             f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg}, p, law_mat, law_scal, ws, k{s})"
         )
-        if s == 0:  # ‖g(x_k)‖∞ and ‖g(x_k) − g_ref‖∞: the first stage has just evaluated g
-            lines += ["    gnorm = 0.0", "    dnorm = 0.0", "    for l in range(NG):",
-                      "        gnorm = max(gnorm, abs(ws.g[l]))",
-                      "        dv[l] = ws.g[l] - gref[l]",
-                      "        dnorm = max(dnorm, abs(dv[l]))"]
+        if s == 0:  # g(x_k): the first stage has just evaluated it
+            lines += ["    for l in range(NG):", "        gv[l] = ws.g[l]"]
     lines += [
         "    for l in range(N2):",
         f"        xn[l] = fma(tau, {weights()}, xk[l])",
         "    return " + ("max(" + ", ".join(f"c{s}" for s in range(stages)) + ")"
-                        if stages > 1 else "c0") + ", gnorm, dnorm",
+                        if stages > 1 else "c0"),
     ]  # fmt: skip
     return "\n".join(lines) + "\n"
 
@@ -166,23 +164,49 @@ def _member_step(rhs, N2: int, NG: int, pattern):
     return njit(forceinline=True, error_model="numpy")(ns["member_step"])
 
 
+def pooled_constraints(model, law) -> int:
+    """The number of holonomic constraints when the constant law acts alike on every
+    constraint (``Ã``'s blocks multiples of the identity, no coupling between f and h:
+    Baumgarte's law), so that the decay measurement pools their pairs into one 2 × 2
+    and one 1 × 1 map; −1 otherwise."""
+    if not law.is_constant:
+        return -1
+    A = law.A_tilde(model)
+    m, k = model.m, model.k
+    f, fd, h = slice(0, m), slice(m, 2 * m), slice(2 * m, 2 * m + k)
+
+    def scalar(block):
+        return block.size == 0 or np.array_equal(block, block[0, 0] * np.eye(block.shape[0]))
+
+    def zero(block):
+        return not np.any(block)
+
+    ok = (scalar(A[fd, f]) and scalar(A[fd, fd]) and scalar(A[h, h]) and zero(A[fd, h])
+          and zero(A[h, f]) and zero(A[h, fd]))  # fmt: skip
+    return m if ok else -1
+
+
 def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the kinds of
-    the scheme's coefficients, block and the shape of the law's matrix)."""
+    the scheme's coefficients, block, the shape of the law's matrix and whether the decay
+    measurement pools the constraints, :func:`pooled_constraints`)."""
     pattern = tableau_pattern(scheme)
     shape = bound.matrix.shape
     n_params = len(model.param_names)
-    return memo(model, ("ensemble", bound.code, bound.fn, pattern, block, shape),
+    pooled = pooled_constraints(model, bound.law)
+    return memo(model, ("ensemble", bound.code, bound.fn, pattern, block, shape, pooled),
                 lambda: build_soa_kernel(kernels_for(model, bound), pattern, block, n_params,
-                                         shape))  # fmt: skip
+                                         shape, pooled))  # fmt: skip
 
 
-def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1)):
+def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1),
+                     pooled: int = -1):  # fmt: skip
     """The block-lockstep ensemble kernel for the kernels ``K``, an explicit scheme whose
     coefficients are of the kinds ``pattern`` (:func:`tableau_pattern`), blocks of
-    ``block`` members, ``n_params`` parameters and a law matrix of shape ``law_shape``
-    (all fixed at compile time; the scheme's coefficients, the parameters and the law's
-    numbers are run-time arrays)."""
+    ``block`` members, ``n_params`` parameters, a law matrix of shape ``law_shape`` and
+    the decay measurement's one-step map pooled over ``pooled`` holonomic constraints
+    (−1: the full map; :func:`.decay.map_width`), all fixed at compile time; the
+    scheme's coefficients, the parameters and the law's numbers are run-time arrays."""
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
     N2, ng = 2 * K.n, K.ng
@@ -192,6 +216,9 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     LR, LC = law_shape
     member_step = _member_step(rhs, N2, ng, pattern)
     stack_workspace = K.stack_workspace
+    (norms, pairs_pooled, pairs_full, levels, record, bin_flush, end_flush, windows_flush,
+     ROWS_FULL) = block_measures(B, ng, K.m)
+    NA = 10 if pooled >= 0 else ROWS_FULL  # rows of the current bin visit's sums
 
     @njit(error_model="numpy")
     def block_norms(X, t, p, gref, nrm, dnrm):
@@ -269,16 +296,16 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
 
     @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
-                   tab_b, tab_c, threshold, g_ref, R, pooled, trace_row, out_norm, meas,
+                   tab_b, tab_c, threshold, g_ref, R, stride, trace_row, out_norm, meas,
                    x_final, status, fail_step, e0, e1, b_lo, b_hi):  # fmt: skip
         """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
         :func:`stabdae.ensemble`.  Member ``i``'s stored samples go to row
         ``trace_row[i]`` of ``out_norm`` (none when −1); its decay measures
         (:mod:`.decay`, from ``‖g‖`` at every step) to row ``i`` of ``meas``, with the
         linear prediction ``g_{k+1} = R g_k`` from ``alpha0s[i]`` when ``R`` is not
-        empty, and its one-step map pooled over the constraints when ``pooled`` (the
-        number of holonomic constraints; −1: the law is not alike on every constraint)
-        is not negative (:func:`.decay.map_buffers`).  The decay is measured on
+        empty (``R`` advances ``stride`` steps: the decay is measured at every
+        ``stride``-th state, :func:`stabdae._ensemble.measure_stride`).  The decay is
+        measured on
         ``‖g_k − g_ref[k]‖∞``, ``g_ref`` the residual of a reference trajectory at every
         step (none when it has no rows: ``‖g_k‖∞``).
         Every output row of the blocks is written here (``out_norm`` NaN after a stop,
@@ -317,17 +344,29 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         ws_h = K_make_workspace()
         xs_h = np.empty(N2)
         nrm_b = np.empty(B)  # the block's residual norms at a stored sample
-        gn_b = np.empty(B)  # ... at the start of the current step
         dn_b = np.empty(B)  # ... and their distances from the reference's
+        gs = stack1(B)  # ‖g‖ at the start of the current step
+        ds = stack1(B)  # ... and its distance from the reference's
         has_ref = g_ref.shape[0] > 0
         gr = stack1(ng)  # the reference's residual at the current step
         for l in range(ng):
             gr[l] = 0.0
         lt, lv, base = ladders(B)  # the decay measurement's ladder per slot
         rt, ry, fa, fb, lg = scratch()
-        # the one-step map's sums per slot, fed from each step's g − g_ref (Dv)
-        S_map, prev_map, lev_map, upto_map = map_buffers(B, ng, pooled)
+        # The measurement (:func:`.decay.block_measures`): the one-step map's sums per
+        # slot and bin, fed from the measured states' g − g_ref (Dv: each step's g, made
+        # g − g_ref, with the norms gs, ds, at a measured one) through the previous one
+        # (P) and the current bin visit's sums (Am); each slot's ladder offset, its level
+        # at the previous measured state and at this one; the largest norms of the fifth.
+        S_map = map_buffers(B, ng, pooled)
         Dv = stack2(ng, B)
+        P = stack2(ng, B)
+        Am = stack2(NA, B)
+        base_s = stack_int1(B)
+        lev = stack_int1(B)
+        nlev = stack_int1(B)
+        wmax = stack1(B)
+        dmax = stack1(B)
         rho_R = spectral_radius_of(R) if R.shape[0] > 0 else math.nan
         g_p = np.empty(alpha0s.shape[1])
         gn_p = np.empty(alpha0s.shape[1])
@@ -352,6 +391,18 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 for l in range(ng):
                     gr[l] = g_ref[0, l]
             block_norms(X, t0, p_s, gr, nrm_b, dn_b)
+            for j in range(B):
+                base_s[j] = ladder_base(dn_b[j])
+                lev[j] = ladder_level(dn_b[j], base_s[j])
+                wmax[j] = -math.inf
+                dmax[j] = -math.inf
+                for l in range(ng):
+                    P[l, j] = 0.0
+                for c in range(NA):
+                    Am[c, j] = 0.0
+            window = 0
+            measured = 0  # steps up to this one have been through (a rollback redoes some)
+            k_last = -1  # the last state measured
             for j in range(cnt):
                 for l in range(N2):
                     xs_h[l] = X[l, j]
@@ -360,7 +411,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 if trace_row[lo + j] >= 0:
                     out_norm[trace_row[lo + j], 0] = nrm
                 begin(lt, lv, base, meas, j, lo + j, nrm, dn_b[j])
-                map_begin(S_map, upto_map, j)
+                map_begin(S_map, j)
                 active[j] = True
                 alive += 1
                 if not (nrm <= threshold):
@@ -390,31 +441,36 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     xk = stack1(N2)
                     xs = stack1(N2)
                     xn = stack1(N2)
-                    dv = stack1(ng)
+                    gv = stack1(ng)
                     for l in range(N2):
                         xk[l] = X[l, j]
-                    c, gn, dn = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn, gr,
-                                            dv)  # fmt: skip
+                    c = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn, gv)
                     for l in range(N2):
                         X[l, j] = xn[l]
-                    for l in range(ng):
-                        Dv[l, j] = dv[l]
                     code[j] |= c
-                    gn_b[j] = gn
-                    dn_b[j] = dn
-                # ‖g‖ at step i − 1 on each running member's ladder (a scatter: apart from
-                # the vectorized loop above); steps done again after a rollback put the
-                # same numbers again
-                window = min(4, (5 * (i - 1)) // nsteps)
-                for j in range(cnt):
-                    if active[j]:
-                        observe(lt, lv, base, meas, j, lo + j, (i - 1) * tau, gn_b[j],
-                                dn_b[j], window)  # fmt: skip
-                        map_observe(S_map, prev_map, lev_map, upto_map, j, i - 1, Dv,
-                                    ladder_level(dn_b[j], base[j]), pooled)  # fmt: skip
+                    for l in range(ng):
+                        Dv[l, j] = gv[l]
+                k = i - 1
+                if i > measured and k % stride == 0:  # state k measured (once: not in a replay)
+                    if min(4, (5 * k) // nsteps) != window:
+                        windows_flush(meas, wmax, dmax, window, active, lo, cnt)
+                        window = min(4, (5 * k) // nsteps)
+                    weight = 1.0 if k_last >= 0 else 0.0  # a pair with the state before
+                    norms(Dv, gr, gs, ds)
+                    if pooled >= 0:
+                        pairs_pooled(Dv, P, Am, weight)
+                    elif ROWS_FULL > 1:
+                        pairs_full(Dv, P, Am, weight)
+                    changed = levels(gs, ds, base_s, lev, nlev, wmax, dmax)
+                    if changed != 0:
+                        bin_flush(S_map, Am, lev, changed, pooled)
+                    record(lt, lv, ds, lev, nlev, k * tau)
+                    k_last = k
+                measured = max(measured, i)
                 until_save -= 1
                 renew = True
                 if i <= careful_to:  # stop the members whose step failed; Xc: the step before
+                    windows_flush(meas, wmax, dmax, window, active, lo, cnt)
                     alive -= stop_failed(X, Xc, code, active, lo, cnt, i - 1, status,
                                          fail_step, x_final, xs_h)  # fmt: skip
                 elif until_save == 0 or i - checkpoint == CHECKPOINT or i == nsteps:
@@ -433,6 +489,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 if until_save == 0:  # a stored sample, of the members whose steps succeeded
                     until_save = save_every
                     block_norms(X, t0 + i * tau, p_s, gr, nrm_b, dn_b)
+                    windows_flush(meas, wmax, dmax, window, active, lo, cnt)
                     for j in range(cnt):
                         if active[j]:
                             nrm = nrm_b[j]
@@ -457,6 +514,9 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 for l in range(ng):
                     gr[l] = g_ref[nsteps, l]
             block_norms(X, tf, p_s, gr, nrm_b, dn_b)
+            windows_flush(meas, wmax, dmax, window, active, lo, cnt)
+            if k_last >= 0:  # the last bin visit's sums
+                end_flush(S_map, Am, lev, active, pooled)
             for j in range(cnt):
                 final = math.nan
                 if active[j]:
@@ -467,12 +527,17 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 for l in range(N2):
                     xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
-                finish(lt, lv, meas, j, lo + j, final, not active[j], tau, rt, ry, fa, fb, lg)
-                map_estimate(S_map, j, ng, pooled, lt, lv, base[j], meas, lo + j, tau, rt, ry)
+                # β from the one-step map where it has one, else from the envelope
+                still = summarize(meas, lo + j, final, not active[j])
+                if active[j] and not map_estimate(S_map, j, ng, pooled, lt, lv, base[j], meas,
+                                                  lo + j, stride * tau, rt, ry):
+                    fit_envelope(lt, lv, meas, j, lo + j, still, stride * tau, rt, ry, fa, fb,
+                                 lg)  # fmt: skip
                 if R.shape[0] > 0:
-                    predict(R, alpha0s[lo + j], nsteps, tau, lt, lv, base, meas, j, lo + j,
-                            rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
+                    predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
+                            meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
 
-    key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape)
-    tag(key, block_norms, retire, stop_failed, block_failed, member_step)
+    key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape, pooled)
+    tag(key, block_norms, retire, stop_failed, block_failed, member_step, norms, pairs_pooled,
+        pairs_full, levels, record, bin_flush, end_flush, windows_flush)
     return keyed_cache(soa_kernel, key)
