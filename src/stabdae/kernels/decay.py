@@ -999,10 +999,10 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry):
     modes' mix or a repeated eigenvalue's polynomial prefactor, where a fit of the norm's
     envelope over a short transient is biased.  The pairs must span a decade
     (``MIN_DECADES``) above the cut; a member without such pairs, or whose map is
-    singular or has ``ρ ≥ 1``, and a growing one (:func:`grows`) are left to the
-    envelope's fit (:func:`fit_envelope`).  Returns whether it gave β."""
+    singular or has ``ρ ≥ 1``, is left to the envelope's fit (:func:`fit_envelope`).
+    Returns whether it gave β."""
     out = meas[row]
-    if S.shape[2] == 0 or grows(out[C_D2], out[C_D3], out[C_D4]):
+    if S.shape[2] == 0:
         return False
     floor = out[C_D4]
     still = (out[C_D2] > out[C_D3] > out[C_D4]

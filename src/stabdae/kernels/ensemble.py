@@ -57,9 +57,15 @@ from numba import njit
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
 from .decay import (
+    C_D2,
+    C_D3,
+    C_D4,
+    C_REASON,
+    R_NOT_DECAYING,
     begin,
     block_measures,
     fit_envelope,
+    grows,
     ladder_base,
     ladder_level,
     ladders,
@@ -527,10 +533,19 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 for l in range(N2):
                     xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
-                # β from the one-step map where it has one, else from the envelope
+                # β from the one-step map where it has one, else from the envelope; a
+                # member whose largest norms grow gets the map only when the envelope
+                # does not find it growing (it may decay first: the map would read that)
                 still = summarize(meas, lo + j, final, not active[j])
-                if active[j] and not map_estimate(S_map, j, ng, pooled, lt, lv, base[j], meas,
-                                                  lo + j, stride * tau, rt, ry):
+                row = meas[lo + j]
+                if active[j] and grows(row[C_D2], row[C_D3], row[C_D4]):
+                    fit_envelope(lt, lv, meas, j, lo + j, still, stride * tau, rt, ry, fa, fb,
+                                 lg)  # fmt: skip
+                    if row[C_REASON] != R_NOT_DECAYING:
+                        map_estimate(S_map, j, ng, pooled, lt, lv, base[j], meas, lo + j,
+                                     stride * tau, rt, ry)  # fmt: skip
+                elif active[j] and not map_estimate(S_map, j, ng, pooled, lt, lv, base[j],
+                                                    meas, lo + j, stride * tau, rt, ry):
                     fit_envelope(lt, lv, meas, j, lo + j, still, stride * tau, rt, ry, fa, fb,
                                  lg)  # fmt: skip
                 if R.shape[0] > 0:
