@@ -542,6 +542,26 @@ def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
 
 
 @njit(cache=True)
+def finish_with_map(lt, lv, S, meas, j, row, final, stopped, ng, pm, base_j, dt, rt, ry, a,
+                    b, lg):  # fmt: skip
+    """:func:`finish` for a member with one-step map sums ``S`` (:func:`map_estimate`,
+    ``dt`` the time between the map's pairs): β from the map where it has one, else from
+    the envelope.  A member whose largest norms grow (:func:`grows`) gets the map only
+    when the envelope does not find it growing (it may decay first, which the map would
+    read), so its envelope is fitted first."""
+    still = summarize(meas, row, final, stopped)
+    if stopped:
+        return
+    out = meas[row]
+    if grows(out[C_D2], out[C_D3], out[C_D4]):
+        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+        if out[C_REASON] != R_NOT_DECAYING:
+            map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry)
+    elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry):
+        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+
+
+@njit(cache=True)
 def fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg):
     """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
     ``still``: the run ended while it was decaying)."""
@@ -684,7 +704,6 @@ def block_measures(B: int, ng: int, pm: int):
     PM, NH = pm, ng - 2 * pm
     FULL = ng if ng <= MAP_MAX_NG else 0
     ROWS_FULL = FULL * (FULL + 1) // 2 + FULL * FULL + 1 if FULL else 1
-    LAST = NBINS - 1
 
     @njit(forceinline=True, error_model="numpy")
     def norms(Dv, gr, gn, dn):
@@ -768,7 +787,7 @@ def block_measures(B: int, ng: int, pm: int):
             ok = d < math.inf
             dm = dmax[j]
             dmax[j] = d if (ok and not (dm >= d)) else dm
-            b = min(max((float_bits(d) >> _SHIFT) - base[j], 0), LAST)
+            b = ladder_level(d, base[j])
             nlev[j] = b if ok else NBINS
             moved = ok and (b >> MAP_SHIFT) != (lev[j] >> MAP_SHIFT)
             changed |= (1 if moved else 0) << j

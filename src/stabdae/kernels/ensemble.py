@@ -57,26 +57,18 @@ from numba import njit
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
 from .decay import (
-    C_D2,
-    C_D3,
-    C_D4,
-    C_REASON,
-    R_NOT_DECAYING,
     begin,
     block_measures,
-    fit_envelope,
-    grows,
+    finish_with_map,
     ladder_base,
     ladder_level,
     ladders,
     map_begin,
     map_buffers,
-    map_estimate,
     observe,
     predict,
     scratch,
     spectral_radius_of,
-    summarize,
 )
 from .fma import fma
 from .rhs import kernels_for
@@ -458,9 +450,10 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                         Dv[l, j] = gv[l]
                 k = i - 1
                 if i > measured and k % stride == 0:  # state k measured (once: not in a replay)
-                    if min(4, (5 * k) // nsteps) != window:
+                    fifth = min(4, (5 * k) // nsteps)
+                    if fifth != window:
                         windows_flush(meas, wmax, dmax, window, active, lo, cnt)
-                        window = min(4, (5 * k) // nsteps)
+                        window = fifth
                     weight = 1.0 if k_last >= 0 else 0.0  # a pair with the state before
                     norms(Dv, gr, gs, ds)
                     if pooled >= 0:
@@ -533,21 +526,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 for l in range(N2):
                     xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
-                # β from the one-step map where it has one, else from the envelope; a
-                # member whose largest norms grow gets the map only when the envelope
-                # does not find it growing (it may decay first: the map would read that)
-                still = summarize(meas, lo + j, final, not active[j])
-                row = meas[lo + j]
-                if active[j] and grows(row[C_D2], row[C_D3], row[C_D4]):
-                    fit_envelope(lt, lv, meas, j, lo + j, still, stride * tau, rt, ry, fa, fb,
-                                 lg)  # fmt: skip
-                    if row[C_REASON] != R_NOT_DECAYING:
-                        map_estimate(S_map, j, ng, pooled, lt, lv, base[j], meas, lo + j,
-                                     stride * tau, rt, ry)  # fmt: skip
-                elif active[j] and not map_estimate(S_map, j, ng, pooled, lt, lv, base[j],
-                                                    meas, lo + j, stride * tau, rt, ry):
-                    fit_envelope(lt, lv, meas, j, lo + j, still, stride * tau, rt, ry, fa, fb,
-                                 lg)  # fmt: skip
+                finish_with_map(lt, lv, S_map, meas, j, lo + j, final, not active[j], ng,
+                                pooled, base[j], stride * tau, rt, ry, fa, fb, lg)  # fmt: skip
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
                             meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
