@@ -35,8 +35,14 @@ def baumgarte_ensemble(name, scheme, xi, **kw):
 
 
 @pytest.mark.parametrize("xi", [0.5, 0.7, 1.0, 2.0])
-@pytest.mark.parametrize("scheme", ["euler", "midpoint", "heun", "rk4"])
-@pytest.mark.parametrize("name", ["pendulum", "double_pendulum"])
+@pytest.mark.parametrize(
+    "name, scheme",
+    [(name, scheme) for name in ("pendulum", "double_pendulum")
+     for scheme in ("euler", "midpoint", "heun", "rk4")]
+    # the generated spherical pendulum with one scheme (its other schemes, and a model of
+    # n = 60, in studies/check_member_rates.py: each scheme is a kernel to compile)
+    + [("spherical_pendulum", "midpoint")],
+)  # fmt: skip
 def test_beta_matches_discrete_prediction(name, scheme, xi):
     """Median β within 2 % of −ln ρ(R(τÃ))/τ (5 % under-damped) and each member's β within
     1 % of its linear prediction's (2 % at the largest perturbations): under-damped (an
@@ -575,21 +581,35 @@ def test_wilson_and_median_intervals():
     assert 0.93 < np.mean(cover) < 0.97
 
 
-def test_traces_are_optional_and_change_no_measurement():
-    """traces='none', a number, 'all': the same β, classes and summaries; the stored
-    traces are those of the named members."""
+def test_traces_and_states_are_optional_and_change_no_measurement():
+    """traces='none', a number, 'all', and states=False: the same β, classes and
+    summaries; the stored traces are those of the named members; the measurements are
+    stored in single precision, the summaries computed in double."""
     model = load_scene("pendulum")
-    run = lambda tr: stabdae.ensemble(model, stabdae.baumgarte(10, 1), "midpoint", 1e-3, 1.0,  # noqa: E731
-                                      members=40, seed=1, traces=tr)  # fmt: skip
-    every, none, some = run("all"), run("none"), run(7)
+    run = lambda tr, st=True: stabdae.ensemble(model, stabdae.baumgarte(10, 1), "midpoint",  # noqa: E731
+                                               1e-3, 1.0, members=40, seed=1, traces=tr,
+                                               states=st)  # fmt: skip
+    every, none, some, bare = run("all"), run("none"), run(7), run(7, False)
     assert none.sizes["trace"] == 0 and every.sizes["trace"] == 40 and some.sizes["trace"] == 7
-    for ds in (none, some):
+    for ds in (none, some, bare):
         np.testing.assert_array_equal(ds.beta.values, every.beta.values)
         np.testing.assert_array_equal(ds.stability_class.values, every.stability_class.values)
     np.testing.assert_array_equal(some.residual_norm.values,
                                   every.residual_norm.sel(trace=some.trace).values)
+    assert "x0" not in bare and "x_final" not in bare and "x_final" in some
+    xr.testing.assert_identical(bare, some.drop_vars(["x0", "x_final"]).assign_attrs(bare.attrs))
+    for name in ("beta", "gamma", "beta_ratio", "fit_start"):
+        assert every[name].dtype == np.float32, name
+    for name in ("max_residual", "residual_floor", "overshoot", "alpha0", "alpha0_norm",
+                 "beta_median"):
+        assert every[name].dtype == np.float64, name
+    assert every.fit_points.dtype == np.int32 and every.diverged_step.dtype == np.int32
+    # the median of the double-precision rates, not of their single-precision copies
+    assert float(every.beta_median) != float(np.median(every.beta.values.astype(float)))
     with pytest.raises(ValueError, match="ensemble: traces must be"):
         run("some")
+    with pytest.raises(TypeError, match=r"ensemble: states must be True or False, got 'no'"):
+        run(7, "no")
 
 
 @njit

@@ -83,6 +83,7 @@ def test_run_writes_dataset_and_pictures_and_refuses_to_overwrite(tmp_path, caps
     assert "stabdae run study.toml: 12 grid points of 64 members" in ds.attrs["history"]
     assert ds.attrs["study"] == "study.toml" and ds.attrs["swept"] == "run.tau, law.omega"
     assert ds.residual_norm.encoding.get("zlib") is True  # written compressed
+    assert "x0" not in ds and "x_final" not in ds  # [ensemble] states: false by default
     # τ = 0.1, 0.2 are larger than save_dt: samples between their steps are NaN
     r = ds.residual_norm.sel(tau=0.2, omega=5.0).values
     assert np.isfinite(r[:, ::4]).all() and np.isnan(r[:, 1::4]).all()

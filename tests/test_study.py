@@ -85,6 +85,8 @@ def test_tau_sweep_snaps_onto_the_sample_grid(tmp_path):
         (("tau = 1e-3", 'tau = "small"'), r"\[run\] tau: must be a number, got str 'small'"),
         (("members = 16", "members = 16.5"), r"\[ensemble\] members: must be an integer"),
         (("seed = 1", "seed = true"), r"\[ensemble\] seed: must be an integer, got bool"),
+        (("seed = 1", "seed = 1\nstates = 1"),
+         r"\[ensemble\] states: must be true or false, got int 1"),
         # impossible values
         (("tau = 1e-3", "tau = -1e-3"), r"\[run\] tau: must be positive and finite, got -0.001"),
         (("radius = [1e-6, 1e-3]", "radius = [1e-3, 1e-6]"),
@@ -189,6 +191,15 @@ def test_two_stage_sweep_changes_the_scheme_per_point(tmp_path, name):
     assert [sc.params["a"] for sc in schemes] == [0.5, 0.25]
     assert schemes[0].b.tolist() != schemes[1].b.tolist() or schemes[0].A.tolist() != \
         schemes[1].A.tolist()
+
+
+def test_states_are_stored_when_the_study_asks(tmp_path):
+    from stabdae.study.run import run_point
+
+    for text, stored in ((BASE, False), (BASE + "states = true\n", True)):
+        study = load_study(write(tmp_path, text))
+        ds = run_point(study, dict(study.points())[()])
+        assert ("x0" in ds and "x_final" in ds) is stored and ds.sizes["member"] == 16
 
 
 @pytest.mark.parametrize(

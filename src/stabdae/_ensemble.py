@@ -24,7 +24,7 @@ from . import _validate as check
 from ._integrate import IntegrationWarning
 from ._laws import Theorem5
 from ._model import Model
-from ._schema import model_coords, provenance, schema_variable, variable
+from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_variable, variable
 from ._schemes import dopri5, dopri5_embedded_weights
 from ._status import Status
 from .kernels import decay
@@ -159,6 +159,7 @@ def ensemble(
     progress=None,
     residual_dtype="float32",
     traces=DEFAULT_TRACES,
+    states: bool = True,
 ) -> xr.Dataset:
     """Integrate an ensemble of initial constraint perturbations in parallel.
 
@@ -211,6 +212,10 @@ def ensemble(
         members (default 64), all of them, or none.  No measurement depends on it: the
         decay rate, floor and class of every member are measured at every step inside
         the kernels.
+    states : bool
+        Store every member's initial and final state (``x0``, ``x_final``: 4n numbers per
+        member, most of the bytes of a large model's ensemble).  ``False`` leaves them
+        out; the members are the same (``alpha0`` and the seed give them again).
 
     Returns
     -------
@@ -275,6 +280,8 @@ def ensemble(
         x0 = check.initial_states(model, x0, who)
         members = x0.shape[0]
     trace_row, traced = _trace_rows(traces, members, who)
+    if not isinstance(states, (bool, np.bool_)):
+        raise TypeError(f"{who}: states must be True or False, got {states!r}")
     bound = check.bound_law(law, model, who)
     R, h_pred = _prediction(law, model, scheme, None if adaptive else tau,
                             float(t_end) - t0)  # fmt: skip
@@ -324,6 +331,8 @@ def ensemble(
         roundoff=_roundoff(model, out["x_final"], status, p, float(out["times"][-1]), gain,
                            threads),
     )  # fmt: skip
+    if not states:
+        ds = ds.drop_vars(["x0", "x_final"])
     # wall times (compilation included on a first call) for benchmarks; not part of the data
     ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
                     wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
@@ -574,6 +583,12 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
     values.update(extra or {})
     values.update(_theory_values(law, model, p, scheme, run.get("tau"), x0, x_final, times,
                                  norms, traced, alpha0, meas[:, C.C_FLOOR]))  # fmt: skip
+    for name in SINGLE_PRECISION:
+        if name in values:
+            values[name] = np.asarray(values[name], dtype=np.float32)
+    for name in COUNTS:
+        if name in values:
+            values[name] = np.asarray(values[name], dtype=np.int32)
     data = {name: schema_variable(name, val, model) for name, val in values.items()}
     data["residual_norm"].attrs["comment"] = (
         f"stored as {norms.dtype}; " + data["residual_norm"].attrs["comment"]

@@ -42,6 +42,15 @@ __all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "prov
 STATE, COMPONENT, RESIDUAL, ENERGY = "@state", "@component", "@residual", "@energy"
 MULTIPLIER, ACCELERATION = "@multiplier", "@acceleration"
 
+#: per-member measurements an ensemble stores in single precision: seven digits are more
+#: than any of them is measured to, and they are most of a large study's bytes (its
+#: summaries are computed before, in double precision).  Residual norms, their ratios and
+#: the energy stay double (a diverging member's exceed the single range), and so does
+#: ``alpha0_norm``, which the stability radius's bracket quotes.
+SINGLE_PRECISION = ("beta", "gamma", "fit_start", "fit_end", "beta_predicted", "beta_ratio")
+#: per-member counts, stored as 32-bit integers
+COUNTS = ("fit_points", "diverged_step", "steps_accepted", "rhs_evaluations")
+
 _FLAG = {"flag_values": [0, 1], "flag_meanings": "no yes"}
 
 
@@ -252,6 +261,10 @@ def schema_markdown() -> str:
         "that holds each entry's unit, from the model's `coordinate_units` and",
         "`constraint_units`.  Every dataset has `created_at` (`YYYY-MM-DDThh:mm:ssZ`, UTC)",
         "and a `history` with one line per action (`<time>: <action> (stabdae <version>)`).",
+        "An ensemble stores " + ", ".join(f"`{n}`" for n in SINGLE_PRECISION) + " in single",
+        "precision (seven digits: more than any of them is measured to) and its counts",
+        "(" + ", ".join(f"`{n}`" for n in COUNTS) + ") as 32-bit integers; `x0` and `x_final`",
+        "are left out with `states=False` (a study's default).",
     ]
     for title, names in _GROUPS:
         out += ["", f"## {title}", "", "| name | dims | units | meaning |", "|---|---|---|---|"]

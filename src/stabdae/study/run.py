@@ -68,7 +68,7 @@ def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dat
                       members=ens["members"], radius=tuple(ens["radius"]), seed=ens["seed"],
                       save_dt=s["save_dt"], params=s["params"], epsilon=s["epsilon"],
                       divergence=s["divergence"], block=ens["block"], threads=threads,
-                      progress=progress)  # fmt: skip
+                      progress=progress, states=ens["states"])  # fmt: skip
     if s["stride"] > 1:  # a step spans several samples: NaN between the steps
         stride = s["stride"]
         t0 = float(ds.time[0])

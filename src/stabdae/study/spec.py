@@ -40,7 +40,8 @@ _SECTIONS = {
                "order": int},
     "run": {"t_end": float, "tau": float, "save_dt": float, "epsilon": float,
             "divergence": float},  # fmt: skip
-    "ensemble": {"members": int, "radius": (list, float), "seed": int, "block": int},
+    "ensemble": {"members": int, "radius": (list, float), "seed": int, "block": int,
+                 "states": bool},
     "sweep": None,  # names checked against the other sections
     "search": {"tau": dict, "q": float, "search_members": int, "steps": int,
                "t_end": float},  # fmt: skip
@@ -260,7 +261,7 @@ def load_study(path, *, members: int | None = None) -> Study:
             fail(f"[run] {key}", f"must be positive and finite, got {run[key]}")
 
     # ensemble
-    ens = {"members": 1024, "radius": [1e-6, 1e-2], "seed": 0, "block": 64}
+    ens = {"members": 1024, "radius": [1e-6, 1e-2], "seed": 0, "block": 64, "states": False}
     ens.update(raw.get("ensemble", {}))
     if members is not None:
         ens["members"] = members
@@ -390,10 +391,11 @@ def _typed(val, kind, key, fail):
             return float(val)
         if k is int and isinstance(val, int) and not isinstance(val, bool):
             return val
-        if k in (str, dict, list) and isinstance(val, k):
+        if k in (str, dict, list, bool) and isinstance(val, k):
             return val
     names = " or ".join({float: "a number", int: "an integer", str: "a string",
-                         dict: "a table", list: "an array"}[k] for k in kinds)  # fmt: skip
+                         dict: "a table", list: "an array", bool: "true or false"}[k]
+                        for k in kinds)  # fmt: skip
     fail(key, f"must be {names}, got {type(val).__name__} {val!r}")
 
 
