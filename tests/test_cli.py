@@ -51,11 +51,12 @@ def test_bad_input_exits_with_a_message(tmp_path):
     assert "must be a whole multiple of tau = 0.3" in proc.stderr
 
 
-def _installed(*args, cwd=None):
+def _installed(*args, cwd=None, env=None):
     """The installed command line (stabdae on PATH next to this Python)."""
     exe = Path(sys.executable).with_name("stabdae")
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "stabdae.study.cli"]
-    return subprocess.run([*cmd, *args], capture_output=True, text=True, cwd=cwd, timeout=600)
+    return subprocess.run([*cmd, *args], capture_output=True, text=True, cwd=cwd, timeout=600,
+                          env=env)  # fmt: skip
 
 
 def test_version_and_one_line_errors(tmp_path):
@@ -76,6 +77,38 @@ def test_version_and_one_line_errors(tmp_path):
     for workers in ("-1", "0", "two"):
         out = _installed("run", "study.toml", "--workers", workers)
         assert out.returncode == 2 and "--workers: expected a positive integer" in out.stderr
+
+
+def test_unreachable_scheduler_and_unwritable_output_give_one_line(tmp_path, monkeypatch,
+                                                                   capsys):  # fmt: skip
+    """An unreachable dask scheduler and an output folder that cannot be written: one line
+    naming the address or the folder, exit 2, before anything is computed."""
+    import os
+
+    from test_run import study_file
+
+    study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
+    env = dict(os.environ, DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT="1s")
+    out = _installed("run", str(study), "--scheduler", "tcp://127.0.0.1:9", "--quiet",
+                     "--no-plots", env=env)  # fmt: skip
+    assert out.returncode == 2 and "Traceback" not in out.stderr, out.stderr
+    assert out.stderr.startswith("stabdae run: error: could not reach the dask scheduler at "
+                                 "tcp://127.0.0.1:9")  # fmt: skip
+    assert out.stderr.strip().count("\n") == 0
+    # a read-only folder (simulated: as root, permissions do not deny writes)
+    mkdir = Path.mkdir
+
+    def read_only(self, *args, **kwargs):
+        if self.name.endswith(".parts"):
+            raise PermissionError(13, "Permission denied", str(self))
+        return mkdir(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "mkdir", read_only)
+    assert main(["run", str(study), "--quiet", "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"stabdae run: error: cannot write in {tmp_path / 'out'} (Permission "
+                   "denied); give an output folder you can write with -o\n")  # fmt: skip
+    assert not (tmp_path / "out" / "study.nc").exists()
 
 
 def test_run_output_folder_orphans_and_foreign_files(tmp_path):
@@ -119,3 +152,17 @@ def test_integrate_with_rk3_and_with_a_tableau(tmp_path, capsys):
                  "-o", str(tmp_path / "rk3.nc")]) == 0  # fmt: skip
     assert main(["integrate", "pendulum", "--tableau", "[1, 2]"]) == 2
     assert "a tableau needs A, b, c and order" in capsys.readouterr().err
+
+
+def test_progress_says_compiling_until_the_kernels_are_ready(tmp_path, capsys):
+    """The progress bar reads "compiling" until the first members are done (no estimate
+    of hours from a rate of zero), then how long the kernels took."""
+    from test_run import study_file
+
+    study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
+    assert main(["run", str(study), "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    assert "stabdae run (compiling)" in err and "kernels ready in" in err
+    assert err.index("stabdae run (compiling)") < err.index("kernels ready in")
+    compiling = err[: err.index("kernels ready in")]
+    assert " 0/48 " in compiling and "?" in compiling  # no rate, no time left guessed

@@ -275,17 +275,32 @@ def test_adaptive_samples_end_exactly_at_t_end():
 
 def test_andrews_multipliers_and_accelerations_against_the_test_set():
     """with_multipliers=True stores λ of (3.11) and v̇: against the Test Set's reference at
-    t = 0.03 (its λ with the opposite sign: it writes M q'' = f − Gᵀλ).  The agreement
-    (measured: positions 9.6, velocities 7.3, λ and accelerations 5.9 digits) is the same
-    from rtol 1e-10 to 1e-13, so it is set by the reference, not by the integration."""
+    t = 0.03 (its λ with the opposite sign: it writes M q'' = f − Gᵀλ).
+
+    The published λ and accelerations agree with the published positions and velocities
+    only to 5.9 digits: λ and v̇ are functions of (q, v) (the index-1 equations
+    M v̇ = f + Fᵀλ, F v̇ = −ḞV), and evaluated at the Test Set's own (q, v) they differ
+    from its λ and v̇ by as much as ours do.  Against that state's λ ours agree to 8 digits
+    and its v̇ to 7.3, the digits our velocities share with the reference's."""
     model = load_scene("andrews")
-    ds = stabdae.integrate_adaptive(model, None, stabdae.baumgarte(1e4, 1.0), 0.03,
-                                    rtol=1e-10, atol=1e-10, with_multipliers=True)  # fmt: skip
+    law = stabdae.baumgarte(1e4, 1.0)
+    ds = stabdae.integrate_adaptive(model, None, law, 0.03, rtol=1e-10, atol=1e-10,
+                                    with_multipliers=True)  # fmt: skip
     assert ds.multiplier.dims == ("time", "constraint") and ds.multiplier.shape[1] == 6
     assert ds.multiplier.attrs["units"] == "J m-1"
     assert digits(ds.x.values[-1, 7:], _refs.ANDREWS_T003_VELOCITY) >= 7.0
-    assert digits(-ds.multiplier.values[-1], _refs.ANDREWS_T003_LAMBDA) >= 5.5
-    assert digits(ds.acceleration.values[-1], _refs.ANDREWS_T003_ACCELERATION) >= 5.5
+    lam, acc = -ds.multiplier.values[-1], ds.acceleration.values[-1]
+    assert digits(lam, _refs.ANDREWS_T003_LAMBDA) >= 5.5
+    assert digits(acc, _refs.ANDREWS_T003_ACCELERATION) >= 5.5
+    # λ and v̇ at the Test Set's own state (no integration: the first sample's)
+    x_ref = np.concatenate([_refs.ANDREWS_T003, _refs.ANDREWS_T003_VELOCITY])
+    at = stabdae.integrate_adaptive(model, x_ref, law, 1e-6, rtol=1e-10, atol=1e-10,
+                                    with_multipliers=True)  # fmt: skip
+    lam_ref, acc_ref = -at.multiplier.values[0], at.acceleration.values[0]
+    published = _refs.ANDREWS_T003_LAMBDA
+    assert abs(digits(lam_ref, published) - digits(lam, published)) < 0.1
+    assert digits(lam, lam_ref) >= 7.5
+    assert digits(acc, acc_ref) >= 7.0
     # at t = 0 the Test Set's consistent initial values: λ = (98.567…, −6.1227…, 0, 0, 0, 0)
     np.testing.assert_allclose(-ds.multiplier.values[0, :2],
                                [98.5668703962410896, -6.12268834425566265], rtol=1e-10)

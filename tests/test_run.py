@@ -112,13 +112,29 @@ def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
                           progress=False, log=lambda *a: None)  # fmt: skip
     env = dict(os.environ, PYTHONPATH=str(SRC))
     cmd = [sys.executable, "-m", "stabdae.study.cli", "run", str(path), "--quiet", "--no-plots"]
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     parts = tmp_path / "out" / "study.nc.parts"
-    deadline = time.time() + 120
-    while time.time() < deadline and len(list(parts.glob("point-*.nc"))) < 2:
-        time.sleep(0.01)
+
+    def start_and_wait_for(points):
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)  # fmt: skip
+        deadline = time.time() + 120
+        while time.time() < deadline and len(list(parts.glob("point-*.nc"))) < points:
+            time.sleep(0.01)
+        return proc
+
+    # Ctrl-C first: one line, exit 130, the points done kept and no lock left behind
+    proc = start_and_wait_for(1)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and err.strip().count("\n") == 0, err
+    assert "interrupted (the grid points done are kept: run the same command to resume)" in err
+    assert len(list(parts.glob("point-*.nc"))) >= 1
+    assert not (parts / "lock").exists()
+    # then SIGKILL, in the middle of the resumed run
+    proc = start_and_wait_for(2)
     os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
+    proc.communicate()
     done = len(list(parts.glob("point-*.nc")))
     assert 2 <= done < 6, done  # killed in the middle
     assert not (tmp_path / "out" / "study.nc").exists()

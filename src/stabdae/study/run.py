@@ -177,8 +177,12 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     manifest = parts / "study.json"
     log(study.describe())
     existed = parts.exists() and any(p.name != "lock" for p in parts.iterdir())
-    parts.mkdir(parents=True, exist_ok=True)
-    lock = _lock(parts)  # first: nothing below may remove another live run's files
+    try:
+        parts.mkdir(parents=True, exist_ok=True)
+        lock = _lock(parts)  # first: nothing below may remove another live run's files
+    except PermissionError as exc:  # before any computing: nothing is lost
+        raise PermissionError(f"cannot write in {out.parent} ({exc.strerror}); give an "
+                              "output folder you can write with -o") from None  # fmt: skip
     try:
         for orphan in out.parent.glob(f".{out.name}.*.tmp"):  # left by a killed write
             orphan.unlink(missing_ok=True)
@@ -309,7 +313,11 @@ def _run_dask(study, todo, parts, workers, scheduler, bar, stamp):
     from dask.distributed import Client, LocalCluster, as_completed
 
     if scheduler:
-        client, cluster = Client(scheduler), None
+        try:  # waits dask's distributed.comm.timeouts.connect (30 s unless configured)
+            client, cluster = Client(scheduler), None
+        except OSError as exc:
+            raise OSError(f"could not reach the dask scheduler at {scheduler} ({exc}); the "
+                          "grid points done so far are kept") from None
     else:
         cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1,
                                processes=True, dashboard_address=None)  # fmt: skip
