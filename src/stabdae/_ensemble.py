@@ -453,8 +453,10 @@ def measure_stride(R) -> int:
     lam = np.linalg.eigvals(np.asarray(R, dtype=float)).astype(complex)
     with np.errstate(divide="ignore"):
         change = np.abs(np.log(lam)).max()
-    if not np.isfinite(change) or change <= 0.0:
-        return 1 if not np.isfinite(change) else MAX_STRIDE
+    if not np.isfinite(change):  # an eigenvalue 0 (ln = −inf): every step
+        return 1
+    if change == 0.0:  # every mode on the unit circle at angle 0: nothing moves
+        return MAX_STRIDE
     return int(min(MAX_STRIDE, max(1, math.floor(STRIDE_CHANGE / change))))
 
 
