@@ -47,7 +47,7 @@ import stabdae
 #     e, ea, rr, ra, l0, ss, sa, sb, sc, sd, ta, tb, u, ua, ub, zf, zt, fa, mom]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     # M = ∂²L/∂v²
     Theta, Phi, Omega = q[1], q[3], q[5]
@@ -110,7 +110,7 @@ def mass(t, q, p, out):
     out[6, 5] = out[5, 6]
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q, so that M v̇ = Fᵀλ − γ  (3.3)
     Theta, gamma, Phi, Omega = q[1], q[2], q[3], q[5]
@@ -192,7 +192,7 @@ def forces(t, q, v, p, out):
     out[6] = e29 * fa - e29 * zf + e30 * fa - e30 * zf
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     beta, Theta, gamma, Phi, delta, Omega, epsilon = q[0], q[1], q[2], q[3], q[4], q[5], q[6]
     xa = p[7]
@@ -221,7 +221,7 @@ def f(t, q, p, out):
     out[5] = -e5 + u * math.cos(epsilon) - zf * math.sin(e6)
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     beta, Theta, gamma, Phi, delta, Omega, epsilon = q[0], q[1], q[2], q[3], q[4], q[5], q[6]
     d, e, rr, ss, u, zf, zt = p[21], p[23], p[25], p[28], p[35], p[38], p[39]
@@ -262,7 +262,7 @@ def f_q(t, q, p, out):
     out[5, 6] = -e11 - u * math.sin(epsilon)
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # f̈ = f_q v̇ + f_accel:  ∂ḟ/∂q v + ∂ḟ/∂t with ḟ = f_q v + f_t
     beta, Theta, gamma, Phi, delta, Omega, epsilon = q[0], q[1], q[2], q[3], q[4], q[5], q[6]

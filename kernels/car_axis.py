@@ -30,7 +30,7 @@ import stabdae
 # p = [eps, M, L, L0, r, w, g]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     # M = ∂²L/∂v²
     eps, M = p[0], p[1]
@@ -42,7 +42,7 @@ def mass(t, q, p, out):
     out[3, 3] = e0
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q, so that M v̇ = Fᵀλ − γ  (3.3)
     xl, yl, xr, yr = q[0], q[1], q[2], q[3]
@@ -61,7 +61,7 @@ def forces(t, q, v, p, out):
     out[3] = e1 + e5 * e7 - e5 - e7 * yr + yr
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     xl, yl, xr, yr = q[0], q[1], q[2], q[3]
     L, r, w = p[2], p[4], p[5]
@@ -71,7 +71,7 @@ def f(t, q, p, out):
     out[1] = -e1 + (xl * xl) - 2.0 * xl * xr + (xr * xr) + (yl * yl) - 2.0 * yl * yr + (yr * yr)
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     xl, yl, xr, yr = q[0], q[1], q[2], q[3]
     L, r, w = p[2], p[4], p[5]
@@ -87,7 +87,7 @@ def f_q(t, q, p, out):
     out[1, 3] = -e2
 
 
-@njit
+@njit(cache=True)
 def f_t(t, q, p, out):
     xl, yl = q[0], q[1]
     L, r, w = p[2], p[4], p[5]
@@ -99,7 +99,7 @@ def f_t(t, q, p, out):
     out[1] = 0.0
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # f̈ = f_q v̇ + f_accel:  ∂ḟ/∂q v + ∂ḟ/∂t with ḟ = f_q v + f_t
     xl, yl = q[0], q[1]

@@ -21,7 +21,7 @@ import stabdae
 # p = [m, I, a, s_h]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     m, inertia, a = p[0], p[1], p[2]
     s, c = math.sin(q[2]), math.cos(q[2])
@@ -36,7 +36,7 @@ def mass(t, q, p, out):
     out[2, 2] = inertia + m * a * a
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # Christoffel terms of T = ½ m |ṙ_G|² + ½ I φ̇², r_G = (x + a cos φ, y + a sin φ)
     m, a = p[0], p[2]
@@ -46,26 +46,26 @@ def forces(t, q, v, p, out):
     out[2] = 0.0
 
 
-@njit
+@njit(cache=True)
 def h(t, q, v, p, out):
     out[0] = p[3] * (-math.sin(q[2]) * v[0] + math.cos(q[2]) * v[1])
 
 
-@njit
+@njit(cache=True)
 def h_q(t, q, v, p, out):
     out[0, 0] = 0.0
     out[0, 1] = 0.0
     out[0, 2] = -p[3] * (math.cos(q[2]) * v[0] + math.sin(q[2]) * v[1])
 
 
-@njit
+@njit(cache=True)
 def h_v(t, q, v, p, out):
     out[0, 0] = -p[3] * math.sin(q[2])
     out[0, 1] = p[3] * math.cos(q[2])
     out[0, 2] = 0.0
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     m, inertia, a = p[0], p[1], p[2]
     s, c = math.sin(q[2]), math.cos(q[2])

@@ -17,7 +17,7 @@ import stabdae
 # p = [m1, m2, l1, l2, g]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     out[:, :] = 0.0
     out[0, 0] = p[0]
@@ -26,7 +26,7 @@ def mass(t, q, p, out):
     out[3, 3] = p[1]
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     out[0] = 0.0
     out[1] = p[0] * p[4]
@@ -34,14 +34,14 @@ def forces(t, q, v, p, out):
     out[3] = p[1] * p[4]
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     dx, dy = q[2] - q[0], q[3] - q[1]
     out[0] = q[0] * q[0] + q[1] * q[1] - p[2] * p[2]
     out[1] = dx * dx + dy * dy - p[3] * p[3]
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     dx, dy = q[2] - q[0], q[3] - q[1]
     out[0, 0] = 2.0 * q[0]
@@ -54,14 +54,14 @@ def f_q(t, q, p, out):
     out[1, 3] = 2.0 * dy
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     du, dw = v[2] - v[0], v[3] - v[1]
     out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
     out[1] = 2.0 * (du * du + dw * dw)
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     kinetic = 0.5 * p[0] * (v[0] ** 2 + v[1] ** 2) + 0.5 * p[1] * (v[2] ** 2 + v[3] ** 2)
     return kinetic + p[4] * (p[0] * q[1] + p[1] * q[3])

@@ -28,7 +28,7 @@ import stabdae
 # p = [m, g, l, d]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     # M = ∂²L/∂v²
     m = p[0]
@@ -39,7 +39,7 @@ def mass(t, q, p, out):
     out[3, 3] = m
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q, so that M v̇ = Fᵀλ − γ  (3.3)
     m, g = p[0], p[1]
@@ -50,7 +50,7 @@ def forces(t, q, v, p, out):
     out[3] = e0
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     x1, y1, x2, y2 = q[0], q[1], q[2], q[3]
     l, d = p[2], p[3]
@@ -65,7 +65,7 @@ def f(t, q, p, out):
     out[3] = -y1 + y2
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     x1, y1, x2, y2 = q[0], q[1], q[2], q[3]
     d = p[3]
@@ -88,7 +88,7 @@ def f_q(t, q, p, out):
     out[3, 3] = 1.0
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # f̈ = f_q v̇ + f_accel:  ∂ḟ/∂q v + ∂ḟ/∂t with ḟ = f_q v + f_t
     x1_dot, y1_dot, x2_dot, y2_dot = v[0], v[1], v[2], v[3]
@@ -100,7 +100,7 @@ def f_accel(t, q, v, p, out):
     out[3] = 0.0
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     # Jacobi integral vᵀ ∂L/∂v − L
     y1, y2 = q[1], q[3]

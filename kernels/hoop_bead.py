@@ -21,21 +21,21 @@ import stabdae
 # p = [g, R, Omega]
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     out[0] = 0.0
     out[1] = 0.0
     out[2] = p[0]
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     s, c = math.sin(p[2] * t), math.cos(p[2] * t)
     out[0] = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] - p[1] * p[1]
     out[1] = -s * q[0] + c * q[1]
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     s, c = math.sin(p[2] * t), math.cos(p[2] * t)
     out[0, 0] = 2.0 * q[0]
@@ -46,7 +46,7 @@ def f_q(t, q, p, out):
     out[1, 2] = 0.0
 
 
-@njit
+@njit(cache=True)
 def f_t(t, q, p, out):
     om = p[2]
     s, c = math.sin(om * t), math.cos(om * t)
@@ -54,7 +54,7 @@ def f_t(t, q, p, out):
     out[1] = -om * (c * q[0] + s * q[1])
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     om = p[2]
     s, c = math.sin(om * t), math.cos(om * t)
@@ -63,7 +63,7 @@ def f_accel(t, q, v, p, out):
     out[1] = -2.0 * om * (c * v[0] + s * v[1]) + om * om * (s * q[0] - c * q[1])
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     om = p[2]
     ux, uy = v[0] + om * q[1], v[1] - om * q[0]  # v − Ω × r

@@ -20,7 +20,7 @@ import stabdae
 # p = [m, J, g, alpha]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     out[:, :] = 0.0
     out[0, 0] = p[0]
@@ -28,7 +28,7 @@ def mass(t, q, p, out):
     out[2, 2] = p[1]
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = ∂V/∂q with V = −m g sin α x
     out[0] = -p[0] * p[2] * math.sin(p[3])
@@ -36,26 +36,26 @@ def forces(t, q, v, p, out):
     out[2] = 0.0
 
 
-@njit
+@njit(cache=True)
 def h(t, q, v, p, out):
     out[0] = math.sin(q[2]) * v[0] - math.cos(q[2]) * v[1]
 
 
-@njit
+@njit(cache=True)
 def h_q(t, q, v, p, out):
     out[0, 0] = 0.0
     out[0, 1] = 0.0
     out[0, 2] = math.cos(q[2]) * v[0] + math.sin(q[2]) * v[1]
 
 
-@njit
+@njit(cache=True)
 def h_v(t, q, v, p, out):
     out[0, 0] = math.sin(q[2])
     out[0, 1] = -math.cos(q[2])
     out[0, 2] = 0.0
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     m, J, g, alpha = p[0], p[1], p[2], p[3]
     return 0.5 * m * (v[0] ** 2 + v[1] ** 2) + 0.5 * J * v[2] ** 2 - m * g * math.sin(alpha) * q[0]

@@ -15,31 +15,31 @@ from numba import njit
 import stabdae
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = ∂V/∂q with V = g y
     out[0] = 0.0
     out[1] = p[0]
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     out[0] = q[0] * q[0] + q[1] * q[1] - p[1] * p[1]
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     out[0, 0] = 2.0 * q[0]
     out[0, 1] = 2.0 * q[1]
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # (d/dt f_q) v = 2 (ẋ² + ẏ²)
     out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     return 0.5 * (v[0] * v[0] + v[1] * v[1]) + p[0] * q[1]
 

@@ -18,7 +18,7 @@ import stabdae
 # p = [g, l0, eps, Omega]
 
 
-@njit
+@njit(cache=True)
 def _length(t, p):
     """l, l̇, l̈ at time t."""
     l0, eps, om = p[1], p[2], p[3]
@@ -26,31 +26,31 @@ def _length(t, p):
     return l0 * (1.0 + eps * s), l0 * eps * om * c, -l0 * eps * om * om * s
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     out[0] = 0.0
     out[1] = p[0]
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     l, _, _ = _length(t, p)
     out[0] = q[0] * q[0] + q[1] * q[1] - l * l
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     out[0, 0] = 2.0 * q[0]
     out[0, 1] = 2.0 * q[1]
 
 
-@njit
+@njit(cache=True)
 def f_t(t, q, p, out):
     l, ldot, _ = _length(t, p)
     out[0] = -2.0 * l * ldot
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # (d/dt f_q) v + d/dt f_t = 2 |v|² − 2 (l̇² + l l̈)
     l, ldot, lddot = _length(t, p)

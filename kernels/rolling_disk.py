@@ -37,7 +37,7 @@ import stabdae
 # p = [m, R, g, w0]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     # M = ∂²L/∂v²
     theta = q[4]
@@ -57,7 +57,7 @@ def mass(t, q, p, out):
     out[5, 3] = out[3, 5]
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q, so that M v̇ = Fᵀλ − γ  (3.3)
     theta = q[4]
@@ -74,14 +74,14 @@ def forces(t, q, v, p, out):
     out[5] = -e2 * phi_dot
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     z, theta = q[2], q[4]
     R = p[1]
     out[0] = -R * math.sin(theta) + z
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     theta = q[4]
     R = p[1]
@@ -90,7 +90,7 @@ def f_q(t, q, p, out):
     out[0, 4] = -R * math.cos(theta)
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # f̈ = f_q v̇ + f_accel:  ∂ḟ/∂q v + ∂ḟ/∂t with ḟ = f_q v + f_t
     theta = q[4]
@@ -99,7 +99,7 @@ def f_accel(t, q, v, p, out):
     out[0] = R * (theta_dot * theta_dot) * math.sin(theta)
 
 
-@njit
+@njit(cache=True)
 def h(t, q, v, p, out):
     phi, theta = q[3], q[4]
     x_dot, y_dot, phi_dot, theta_dot, psi_dot = v[0], v[1], v[3], v[4], v[5]
@@ -115,7 +115,7 @@ def h(t, q, v, p, out):
     out[1] = e1 * e4 + e2 * e6 + e3 * e5 + y_dot
 
 
-@njit
+@njit(cache=True)
 def h_q(t, q, v, p, out):
     phi, theta = q[3], q[4]
     phi_dot, theta_dot, psi_dot = v[3], v[4], v[5]
@@ -134,7 +134,7 @@ def h_q(t, q, v, p, out):
     out[1, 4] = R * (e1 * e3 * theta_dot - e6 * phi_dot)
 
 
-@njit
+@njit(cache=True)
 def h_v(t, q, v, p, out):
     phi, theta = q[3], q[4]
     R = p[1]
@@ -153,7 +153,7 @@ def h_v(t, q, v, p, out):
     out[1, 5] = e3
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     # Jacobi integral vᵀ ∂L/∂v − L
     z, theta = q[2], q[4]

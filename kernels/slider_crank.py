@@ -33,7 +33,7 @@ import stabdae
 # p = [r, l, m1, m2, m3, w0]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     # M = ∂²L/∂v²
     phi, psi = q[0], q[1]
@@ -46,7 +46,7 @@ def mass(t, q, p, out):
     out[1, 0] = out[0, 1]
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q, so that M v̇ = Fᵀλ − γ  (3.3)
     phi, psi = q[0], q[1]
@@ -58,7 +58,7 @@ def forces(t, q, v, p, out):
     out[2] = 0.0
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     phi, psi, xs = q[0], q[1], q[2]
     r, l = p[0], p[1]
@@ -66,7 +66,7 @@ def f(t, q, p, out):
     out[1] = l * math.sin(psi) + r * math.sin(phi)
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     phi, psi = q[0], q[1]
     r, l = p[0], p[1]
@@ -78,7 +78,7 @@ def f_q(t, q, p, out):
     out[1, 1] = l * math.cos(psi)
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # f̈ = f_q v̇ + f_accel:  ∂ḟ/∂q v + ∂ḟ/∂t with ḟ = f_q v + f_t
     phi, psi = q[0], q[1]
@@ -90,7 +90,7 @@ def f_accel(t, q, v, p, out):
     out[1] = -e0 * math.sin(psi) - e1 * math.sin(phi)
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     # Jacobi integral vᵀ ∂L/∂v − L
     phi, psi = q[0], q[1]

@@ -30,7 +30,7 @@ import stabdae
 # p = [m, g, l]
 
 
-@njit
+@njit(cache=True)
 def mass(t, q, p, out):
     # M = ∂²L/∂v²
     m = p[0]
@@ -40,7 +40,7 @@ def mass(t, q, p, out):
     out[2, 2] = m
 
 
-@njit
+@njit(cache=True)
 def forces(t, q, v, p, out):
     # γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q, so that M v̇ = Fᵀλ − γ  (3.3)
     m, g = p[0], p[1]
@@ -49,14 +49,14 @@ def forces(t, q, v, p, out):
     out[2] = g * m
 
 
-@njit
+@njit(cache=True)
 def f(t, q, p, out):
     x, y, z = q[0], q[1], q[2]
     l = p[2]
     out[0] = -(l * l) + (x * x) + (y * y) + (z * z)
 
 
-@njit
+@njit(cache=True)
 def f_q(t, q, p, out):
     x, y, z = q[0], q[1], q[2]
     out[0, 0] = 2.0 * x
@@ -64,14 +64,14 @@ def f_q(t, q, p, out):
     out[0, 2] = 2.0 * z
 
 
-@njit
+@njit(cache=True)
 def f_accel(t, q, v, p, out):
     # f̈ = f_q v̇ + f_accel:  ∂ḟ/∂q v + ∂ḟ/∂t with ḟ = f_q v + f_t
     x_dot, y_dot, z_dot = v[0], v[1], v[2]
     out[0] = 2.0 * (x_dot * x_dot) + 2.0 * (y_dot * y_dot) + 2.0 * (z_dot * z_dot)
 
 
-@njit
+@njit(cache=True)
 def energy(t, q, v, p):
     # Jacobi integral vᵀ ∂L/∂v − L
     z = q[2]

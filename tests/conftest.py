@@ -47,9 +47,10 @@ def load_scene(name: str) -> stabdae.Model:
 
 def scene_module(name: str):
     """The scene's module (for its closed-form helpers)."""
+    from stabdae._loading import module_name
+
     load_scene(name)
-    key = next(k for k in sys.modules if k.startswith(f"stabdae_model_{name}_"))
-    return sys.modules[key]
+    return sys.modules[module_name(KERNELS / f"{name}.py")]
 
 
 def rhs_function(model: stabdae.Model, law):

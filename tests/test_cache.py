@@ -276,3 +276,56 @@ def test_without_numbas_private_caching_api_kernels_compile_in_memory(monkeypatc
     with pytest.warns(RuntimeWarning, match="kernel cache unavailable"):
         assert kc.keyed_cache(d, "some-key") is d
     assert d._cache is before and d(1.5) == 3.0
+
+
+IMPORT_PLAIN = textwrap.dedent(
+    """
+    import sys
+    sys.path.insert(0, sys.argv[1])
+    import pendulum_cached
+    print(pendulum_cached.model.name, pendulum_cached.__name__)
+    """
+)
+LOAD = textwrap.dedent(
+    """
+    import sys
+    import stabdae
+    model = stabdae.load_model(sys.argv[1])
+    print(model.name, [k for k, m in sys.modules.items()
+                       if not k.startswith("__") and getattr(m, "model", None) is model])
+    """
+)
+
+
+def test_a_cached_model_file_loads_and_imports_under_one_name(tmp_path):
+    """A model file whose functions are ``@njit(cache=True)``: numba's entries name the
+    module they were compiled in.  load_model gives the file the name a plain import does,
+    so a process that imports it and one that loads it share the entries both ways; an
+    entry made under another name (here: loaded with importlib under a made-up one) is
+    passed over, not an error."""
+    model_file = tmp_path / "pendulum_cached.py"
+    model_file.write_text((scene_dir() / "pendulum.py").read_text())
+    assert "@njit(cache=True)" in model_file.read_text()
+    env = dict(os.environ, PYTHONPATH=str(SRC), STABDAE_CACHE_DIR=str(tmp_path / "cache"))
+
+    def run(code, arg):
+        out = subprocess.run([sys.executable, "-c", code, str(arg)], env=env, text=True,
+                             capture_output=True, timeout=300)  # fmt: skip
+        assert out.returncode == 0, out.stderr
+        return out.stdout.strip().splitlines()[-1]
+
+    other_name = textwrap.dedent(
+        """
+        import importlib.util, sys
+        spec = importlib.util.spec_from_file_location("elsewhere_named", sys.argv[1])
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["elsewhere_named"] = module
+        spec.loader.exec_module(module)
+        print(module.model.name)
+        """
+    )
+    assert run(other_name, model_file) == "pendulum"  # entries made under "elsewhere_named"
+    assert any((tmp_path / "__pycache__").glob("*.nbi"))
+    assert run(LOAD, model_file) == "pendulum ['pendulum_cached']"
+    assert run(IMPORT_PLAIN, tmp_path) == "pendulum pendulum_cached"
+    assert run(LOAD, model_file) == "pendulum ['pendulum_cached']"

@@ -114,16 +114,22 @@ def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
     cmd = [sys.executable, "-m", "stabdae.study.cli", "run", str(path), "--quiet", "--no-plots"]
     parts = tmp_path / "out" / "study.nc.parts"
 
-    def start_and_wait_for(points):
-        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                text=True)  # fmt: skip
+    # A process started from a background job inherits SIGINT ignored, and Python then
+    # installs no handler for it: the Ctrl-C phase restores Python's own first.
+    with_sigint = [sys.executable, "-c", "import signal, sys; signal.signal(signal.SIGINT, "
+                   "signal.default_int_handler); from stabdae.study.cli import main; "
+                   "sys.exit(main(sys.argv[1:]))", *cmd[3:]]  # fmt: skip
+
+    def start_and_wait_for(points, command=cmd):
+        proc = subprocess.Popen(command, env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)  # fmt: skip
         deadline = time.time() + 120
         while time.time() < deadline and len(list(parts.glob("point-*.nc"))) < points:
             time.sleep(0.01)
         return proc
 
     # Ctrl-C first: one line, exit 130, the points done kept and no lock left behind
-    proc = start_and_wait_for(1)
+    proc = start_and_wait_for(1, with_sigint)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err

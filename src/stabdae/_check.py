@@ -9,6 +9,8 @@ f_accel    d/dt (f_q v + f_t) along q̇ = v: ``(d/dt f_q) v + d/dt f_t``
 h_q, h_v   ∂h/∂q, ∂h/∂v
 h_t        ∂h/∂t (zero when the model declares no h_t)
 mass       symmetric to 1e-12 relative, and positive definite
+sparsity   every non-zero of mass, f_q, h_q, h_v inside the pattern the model
+           declared or detected (the sparse right-hand side reads nothing else)
 ========== ==============================================================
 
 A piece fails when ``max |analytic − finite difference| > rtol · max(1, max |fd|, max |analytic|)``.
@@ -181,6 +183,18 @@ def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> N
         add("h_v", ev("h_v", t, x, p), _jacobian(lambda vv: ev("h", t, with_v(vv), p), v))
         add("h_t", ev("h_t", t, x, p), _scalar_derivative(lambda s: ev("h", s, x, p), t),
             "" if "h_t" in model.functions else "model declares none")  # fmt: skip
+    for piece, pattern in (model.patterns or {}).items():
+        value = ev(piece, t, x, p)
+        outside = np.abs(np.where(pattern, 0.0, value))
+        outside[np.isnan(value) & ~pattern] = np.inf
+        worst = float(outside.max(initial=0.0))
+        detail = f"{piece}: every non-zero inside its pattern"
+        if worst > 0:
+            entry = [int(j) for j in np.unravel_index(int(np.argmax(outside)), outside.shape)]
+            how = "declared" if piece in model._declared else "detected at construction"
+            detail = (f"{piece} out{entry} = {float(value[tuple(entry)])!r}, an entry its "
+                      f"sparsity pattern ({how}) marks structurally zero")
+        report.rows.append(CheckRow("sparsity", i, worst, 0.0, detail))
     if model.has_mass:
         M = ev("mass", t, x, p)
         asym = float(np.max(np.abs(M - M.T)))

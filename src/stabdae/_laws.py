@@ -22,7 +22,7 @@ from numba.core.dispatcher import Dispatcher
 
 from ._model import Model, ModelError, probe_output
 from .kernels.jit import is_njit
-from .kernels.rhs import LAW_ACPR, LAW_CONSTANT, LAW_THEOREM5, LAW_USER
+from .kernels.rhs import LAW_ACPR, LAW_CONSTANT, LAW_SCALAR_BLOCKS, LAW_THEOREM5, LAW_USER
 
 __all__ = [
     "Law", "BoundLaw", "baumgarte", "matrix", "theorem5", "none", "user", "acpr", "as_law",
@@ -73,8 +73,11 @@ class Law:
         raise NotImplementedError
 
     def bind(self, model: Model) -> BoundLaw:
-        A = self.A(model)
-        return BoundLaw(self, LAW_CONSTANT, np.ascontiguousarray(A), np.zeros(1))
+        A = np.ascontiguousarray(self.A(model))
+        factors = _scalar_blocks(A, model.m, model.k)
+        if factors is not None and model.sparse_structure() is not None:
+            return BoundLaw(self, LAW_SCALAR_BLOCKS, factors, np.zeros(1))
+        return BoundLaw(self, LAW_CONSTANT, A, np.zeros(1))
 
     def A_tilde(self, model: Model, x=None, t=None, p=None) -> np.ndarray:
         """The full (2m + k) × (2m + k) matrix ``Ã`` of (3.9).
@@ -406,6 +409,20 @@ def as_law(law) -> Law:
         f"law must be a stabdae law (baumgarte, matrix, theorem5, none, acpr, user) or an @njit "
         f"function A(t, x, p, out); got {type(law).__name__}"
     )
+
+
+def _scalar_blocks(A: np.ndarray, m: int, k: int) -> np.ndarray | None:
+    """``[[a_f, a_ḟ, a_h]]`` when ``A = [[a_f I, a_ḟ I, 0], [0, 0, a_h I]]``, else None."""
+    a = np.zeros(3)
+    expected = np.zeros_like(A)
+    if m:
+        a[0], a[1] = A[0, 0], A[0, m]
+        expected[:m, :m] = a[0] * np.eye(m)
+        expected[:m, m:2 * m] = a[1] * np.eye(m)
+    if k:
+        a[2] = A[m, 2 * m]
+        expected[m:, 2 * m:] = a[2] * np.eye(k)
+    return a.reshape(1, 3) if np.array_equal(A, expected) else None
 
 
 def bind_law(law, model: Model) -> BoundLaw:

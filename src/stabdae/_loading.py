@@ -5,12 +5,14 @@ from __future__ import annotations
 import ast
 import hashlib
 import importlib.util
+import keyword
 import sys
 from pathlib import Path
 
 from ._model import Model, ModelError
 
-__all__ = ["load_model", "local_imports", "model_file", "scene_names", "scene_dir"]
+__all__ = ["load_model", "local_imports", "model_file", "module_name", "scene_names",
+           "scene_dir"]
 
 
 def scene_dir() -> Path:
@@ -71,6 +73,42 @@ def local_imports(path: Path) -> list[Path]:
     return seen
 
 
+def module_name(path: Path) -> str:
+    """The name a model file is loaded under: the one a plain ``import`` of it would give
+    (``stabdae.scenes.<name>`` for an installed scene, else the file's stem) unless that
+    name belongs to another module, else a name made from the path.
+
+    Numba's on-disk cache (``@njit(cache=True)`` in the model file) keys its entries by
+    file and function, and a cached function refers to its module by name: a file loaded
+    here under one name and imported elsewhere under another would find entries it cannot
+    load."""
+    path = Path(path).resolve()
+    if path.parent == Path(__file__).with_name("scenes").resolve():
+        return f"stabdae.scenes.{path.stem}"
+    stem = path.stem
+    if stem.isidentifier() and not keyword.iskeyword(stem):
+        existing = sys.modules.get(stem)
+        if existing is not None:
+            if _origin(getattr(existing, "__file__", None)) == path:
+                return stem
+        else:
+            try:
+                spec = importlib.util.find_spec(stem)
+            except (ImportError, ValueError):
+                spec = None
+            if spec is None or _origin(spec.origin) == path:
+                return stem
+    digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
+    return f"stabdae_model_{stem}_{digest}"
+
+
+def _origin(file) -> Path | None:
+    try:
+        return Path(file).resolve() if file else None
+    except (OSError, TypeError):
+        return None
+
+
 def load_model(source, attribute: str = "model") -> Model:
     """Load a model from a file path or the name of a built-in scene.
 
@@ -88,8 +126,7 @@ def load_model(source, attribute: str = "model") -> Model:
     (2, 1)
     """
     path = model_file(source)
-    digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
-    name = f"stabdae_model_{path.stem}_{digest}"
+    name = module_name(path)
     if name in sys.modules:
         module = sys.modules[name]
     else:

@@ -49,6 +49,8 @@ _PIECES: dict[str, tuple[str, Callable[[int, int, int], tuple[int, ...]], str]] 
     "h_v": ("tqvp", lambda n, m, k: (k, n), "k, n"),
     "h_t": ("tqvp", lambda n, m, k: (k,), "k"),
 }
+#: pieces whose structural zeros the sparse right-hand side uses
+_PATTERNED = ("mass", "f_q", "h_q", "h_v")
 _HOLONOMIC = ("f", "f_q", "f_t", "f_accel")
 _NONHOLONOMIC = ("h", "h_q", "h_v", "h_t")
 _REQUIRED_IF_M = ("f", "f_q", "f_accel")
@@ -136,7 +138,10 @@ class Model:
         energy_units: str = "1",
         t0: float = 0.0,
         description: str = "",
+        sparsity: str | Mapping[str, np.ndarray] = "detect",
     ):
+        self._args = {key: value for key, value in locals().items()
+                      if key not in ("self", "__class__")}  # for :meth:`replace`
         self.name = str(name)
         self.n, self.m, self.k = (self._count(v, s) for v, s in ((n, "n"), (m, "m"), (k, "k")))
         if self.n < 1:
@@ -175,8 +180,9 @@ class Model:
         p = self.default_params()
         self._reference = reference_state
         x_ref = self.reference_state(p)
-        self._probe_all(x_ref, p)
+        outputs = self._probe_all(x_ref, p)
         self._check_consistent(x_ref, p)
+        self.patterns = self._sparsity(sparsity, x_ref, p, outputs)
         self._kernel_cache: dict = {}
 
     # ----------------------------------------------------------------- properties
@@ -254,6 +260,17 @@ class Model:
             f"params={dict(self.params)}, pieces=[{pieces}])"
         )
 
+    def replace(self, **changes) -> Model:
+        """A new model with the same arguments as this one but ``changes``, e.g.
+        ``model.replace(sparsity="dense")``; it is validated like any model."""
+        unknown = set(changes) - set(self._args)
+        if unknown:
+            raise ModelError(
+                f"Model.replace: {sorted(unknown)} are not arguments of Model; arguments: "
+                f"{sorted(self._args)}"
+            )
+        return Model(**{**self._args, **changes})
+
     # ----------------------------------------------------------------- parameters
     def default_params(self) -> np.ndarray:
         """The parameter vector ``p`` with the model's default values."""
@@ -310,7 +327,7 @@ class Model:
         if piece == "energy":
             if self.energy is None:
                 raise ModelError(f"Model {self.name!r} has no energy function")
-            return float(self.energy(float(t), q, v, p))
+            return float(_call_compiled(self.energy, float(t), q, v, p))
         if piece not in _PIECES:
             raise ModelError(f"unknown model piece {piece!r}; pieces: {list(_PIECES)}")
         pattern, shape_of, _ = _PIECES[piece]
@@ -322,7 +339,7 @@ class Model:
             return np.zeros(shape)
         out = np.zeros(shape)
         args = (float(t), q, p) if pattern == "tqp" else (float(t), q, v, p)
-        fn(*args, out)
+        _call_compiled(fn, *args, out)
         return out
 
     def residual(self, x: np.ndarray, t: float | None = None, p: np.ndarray | None = None):
@@ -427,7 +444,7 @@ class Model:
             f"got {kind}; decorate it with @numba.njit"
         )
 
-    def _probe_all(self, x: np.ndarray, p: np.ndarray) -> None:
+    def _probe_all(self, x: np.ndarray, p: np.ndarray) -> dict:
         q, v = x[: self.n].copy(), x[self.n :].copy()
         t = self.t0
         outputs = self._probe_at(t, x, p)
@@ -435,6 +452,120 @@ class Model:
             self._check_symmetric(outputs["mass"])
         if self.energy is not None:
             self._probe_energy(t, q, v, p)
+        return outputs
+
+    # ----------------------------------------------------------------- sparsity
+    def _sparsity(self, sparsity, x_ref, p, outputs) -> dict | None:
+        """The structural patterns of ``mass``, ``f_q``, ``h_q``, ``h_v`` (declared, or
+        found by :meth:`_detect`), or None for ``sparsity="dense"``."""
+        self._sparsity_mode = "detect"
+        self._declared: tuple[str, ...] = ()
+        declared = {}
+        if isinstance(sparsity, str):
+            if sparsity not in ("detect", "dense", "sparse"):
+                raise ModelError(
+                    f"Model {self.name!r}: sparsity must be 'detect', 'dense', 'sparse' or a "
+                    f"mapping of {list(_PATTERNED)} to boolean arrays, got {sparsity!r}"
+                )
+            if sparsity == "dense":
+                self._sparsity_mode = "dense"
+                return None
+            self._sparsity_mode = sparsity
+        elif isinstance(sparsity, Mapping):
+            for piece, pattern in sparsity.items():
+                if piece not in _PATTERNED or piece not in self.functions:
+                    raise ModelError(
+                        f"Model {self.name!r}: sparsity declares a pattern for {piece!r}, "
+                        f"which is not one of the model's pieces "
+                        f"{[q for q in _PATTERNED if q in self.functions]}"
+                    )
+                shape = _PIECES[piece][1](self.n, self.m, self.k)
+                arr = np.asarray(pattern)
+                if arr.shape != shape:
+                    raise ModelError(
+                        f"Model {self.name!r}: the sparsity pattern of {_call_signature(piece)} "
+                        f"must have the shape of out, {shape}, got {arr.shape}"
+                    )
+                declared[piece] = arr.astype(bool)
+        else:
+            raise ModelError(
+                f"Model {self.name!r}: sparsity must be 'detect', 'dense', 'sparse' or a "
+                f"mapping of {list(_PATTERNED)} to boolean arrays, got "
+                f"{type(sparsity).__name__}"
+            )
+        patterns = self._detect(x_ref, p)
+        for piece, pattern in declared.items():
+            outside = (outputs[piece] != 0) & ~pattern
+            if outside.any():
+                i = tuple(int(j) for j in np.argwhere(outside)[0])
+                raise ModelError(
+                    f"Model {self.name!r}: {_call_signature(piece)} writes "
+                    f"out{list(i)} = {outputs[piece][i]!r} at the reference state, an "
+                    "entry its declared sparsity pattern marks structurally zero"
+                )
+            patterns[piece] = pattern
+        self._declared = tuple(declared)
+        return patterns
+
+    def _detect(self, x_ref, p, states: int = 4, seed: int = 0) -> dict:
+        """An entry is structurally zero when it is exactly zero at the reference state
+        and at ``states`` random states around it (displaced by 1e-3 and 0.3 of each
+        coordinate's scale, at random times when the model depends on time)."""
+        rng = np.random.default_rng(seed)
+        scale = np.maximum(1.0, np.abs(x_ref))
+        xs, ts = [x_ref], [self.t0]
+        for i in range(states):
+            radius = 1e-3 if i % 2 == 0 else 0.3
+            xs.append(x_ref + radius * scale * rng.standard_normal(x_ref.shape))
+            ts.append(self.t0 + (rng.uniform(0.0, 1.0) if self.time_dependent else 0.0))
+        patterns = {}
+        for piece in _PATTERNED:
+            if piece not in self.functions:
+                continue
+            pattern = None
+            for x, t in zip(xs, ts):
+                with np.errstate(all="ignore"):
+                    nz = self.evaluate(piece, t, x, p) != 0  # NaN counts as non-zero
+                pattern = nz if pattern is None else pattern | nz
+            patterns[piece] = pattern
+        return patterns
+
+    def sparse_structure(self):
+        """The index lists of the sparse right-hand side (:mod:`stabdae.kernels.sparsity`),
+        or None where the dense one is used: ``sparsity="dense"``, a mass matrix that is
+        not diagonal, or (``sparsity="detect"`` or declared patterns) a structure that
+        saves less than half the dense path's multiply-adds."""
+        if getattr(self, "_structure", False) is not False:
+            return self._structure
+        from .kernels.sparsity import dense_cost, sparse_cost, structure
+
+        st = None
+        pats = self.patterns
+        diagonal = not self.has_mass or (
+            pats is not None and not (pats["mass"] & ~np.eye(self.n, dtype=bool)).any())
+        if pats is not None and diagonal:
+            F = np.zeros((self.r, self.n), dtype=bool)
+            if self.m:
+                F[: self.m] = pats["f_q"]
+            if self.k:
+                F[self.m:] = pats["h_v"]
+            st = structure(F, pats.get("h_q"))
+            if self._sparsity_mode != "sparse" and 2 * sparse_cost(st) > dense_cost(self.n,
+                                                                                  self.r):
+                st = None
+        self._structure = st
+        return st
+
+    def structure_key(self) -> str:
+        """What the compiled sparse right-hand side depends on: the patterns."""
+        import hashlib
+
+        h = hashlib.sha1()
+        for piece in _PATTERNED:
+            if self.patterns is not None and piece in self.patterns:
+                pat = self.patterns[piece]
+                h.update(f"{piece}{pat.shape}".encode() + np.packbits(pat).tobytes())
+        return h.hexdigest()[:16]
 
     def _probe_at(self, t: float, x: np.ndarray, p: np.ndarray, where: str = "") -> dict:
         """Run every piece at ``(t, x)`` through :func:`probe_output` (first as Python, with
@@ -468,7 +599,7 @@ class Model:
 
     def _probe_energy(self, t, q, v, p) -> None:
         try:
-            e = self.energy(t, q, v, p)
+            e = _call_compiled(self.energy, t, q, v, p)
         except Exception as exc:
             raise ModelError(
                 f"Model {self.name!r}: energy(t, q, v, p) failed at the reference state: "
@@ -551,13 +682,28 @@ def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs:
         )
     compiled = np.zeros(shape)
     try:
-        fn(*args, compiled)
+        _call_compiled(fn, *args, compiled)
     except Exception as exc:  # numba typing errors come in many classes
         raise ModelError(
             f"{where} failed to compile or run with float64 scalars and C-contiguous float64 "
             f"arrays (out of shape {shape}): {_first_lines(exc)}"
         ) from exc
     return compiled
+
+
+def _call_compiled(fn: Dispatcher, *args):
+    """``fn(*args)``; an entry of numba's on-disk cache that refers to a module this
+    process cannot import (the file was loaded under another name when it was cached) is
+    passed over: the function compiles instead, and is not cached in this process."""
+    try:
+        return fn(*args)
+    except ModuleNotFoundError:
+        from numba.core.caching import NullCache
+
+        if isinstance(getattr(fn, "_cache", None), NullCache):
+            raise
+        fn._cache = NullCache()
+        return fn(*args)
 
 
 def _probe_boundscheck(where, fn, args, shape, governs) -> np.ndarray:

@@ -547,7 +547,7 @@ def _function(piece: str, expr, names: _LocalNames) -> str:
                         body.append(f"out[{i}, {j}] = out[{j}, {i}]")
     comment = [f"# {_COMMENTS[piece]}"] if piece in _COMMENTS else []
     lines = comment + body
-    return (f"@njit\ndef {piece}({_signature(piece)}):\n"
+    return (f"@njit(cache=True)\ndef {piece}({_signature(piece)}):\n"
             + "\n".join("    " + ln for ln in "\n".join(lines).splitlines()))  # fmt: skip
 
 

@@ -190,3 +190,59 @@ def pinv_solve_sym(a, n, b, rtol, V, w, tmp):
             s += V[k, i] * tmp[i]
         b[k] = s
     return rank
+
+
+@njit(cache=True, error_model="numpy", forceinline=True)
+def ldl_sparse_inplace(a, n, rtol, lptr, lcol, optr, oq):
+    """:func:`ldl_inplace` on the factor's pattern only (:func:`.sparsity.structure`): the
+    strict lower entries of row ``j`` are ``lcol[lptr[j]:lptr[j+1]]``, and for the ``e``-th
+    of them, ``(j, p)``, the ``q < p`` with both ``L[j, q]`` and ``L[p, q]`` non-zero are
+    ``oq[optr[e]:optr[e+1]]``.  The same operations in the same order as the dense
+    factorization without its structurally zero terms; entries off the pattern are neither
+    read nor written (the fill must hold zeros on entry)."""
+    dmax = abs(a[0, 0])
+    for i in range(1, n):
+        dmax = max(dmax, abs(a[i, i]))
+    tol = rtol * dmax
+    fail = 0
+    for j in range(n):
+        for e in range(lptr[j], lptr[j + 1]):
+            p = lcol[e]
+            s = a[j, p]
+            for o in range(optr[e], optr[e + 1]):
+                q = oq[o]
+                s = fma(-a[j, q], a[p, q], s)
+            a[j, p] = s
+        d = a[j, j]
+        for e in range(lptr[j], lptr[j + 1]):
+            p = lcol[e]
+            w = a[j, p]
+            ljp = w * a[p, p]
+            d = fma(-w, ljp, d)
+            a[j, p] = ljp
+        bad = not (d > tol)
+        fail += (j + 1) * (bad & (fail == 0))
+        a[j, j] = 1.0 / d
+    return fail
+
+
+@njit(cache=True, error_model="numpy", forceinline=True)
+def ldl_sparse_solve(l, n, b, lptr, lcol, ltptr, lrow):
+    """:func:`ldl_solve_inplace` for a factor of :func:`ldl_sparse_inplace`; ``lrow[
+    ltptr[i]:ltptr[i+1]]`` are the rows of column ``i``'s strict lower entries.  With ``n``
+    smaller than the factor, the leading ``n × n`` block's system is solved."""
+    for i in range(n):
+        s = b[i]
+        for e in range(lptr[i], lptr[i + 1]):
+            p = lcol[e]
+            s = fma(-l[i, p], b[p], s)
+        b[i] = s
+    for i in range(n):
+        b[i] *= l[i, i]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for e in range(ltptr[i], ltptr[i + 1]):
+            p = lrow[e]
+            if p < n:  # (a leading block of the factor: rows below it left out)
+                s = fma(-l[p, i], b[p], s)
+        b[i] = s

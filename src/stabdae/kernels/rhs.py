@@ -33,13 +33,21 @@ import math
 from collections import namedtuple
 from typing import TYPE_CHECKING
 
+import numpy as np
 from numba import njit
 
 from .._status import Status
 from .cache import fingerprint, memo, optional_fingerprint, tag
 from .fma import fma
 from .jit import python_function
-from .linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace, pinv_solve_sym
+from .linalg import (
+    ldl_inplace,
+    ldl_solve_columns,
+    ldl_solve_inplace,
+    ldl_sparse_inplace,
+    ldl_sparse_solve,
+    pinv_solve_sym,
+)
 from .workspace import builders
 
 if TYPE_CHECKING:
@@ -51,6 +59,10 @@ LAW_CONSTANT = 0  # A given as a runtime matrix
 LAW_THEOREM5 = 1  # A22 = −k W(x) L,  W = h_v h_vᵀ  (m = 0)
 LAW_USER = 2  # A(t, x, p, out) evaluated in the kernel
 LAW_ACPR = 3  # A = 0 plus the correction −γ_s D (G D)⁻¹ g of Ascher, Chin, Petzold, Reich
+#: a constant A whose blocks are multiples of the identity (Baumgarte's), given by its three
+#: factors (f, ḟ, h) as a 1 × 3 matrix: the same sums as LAW_CONSTANT without their zero
+#: terms (bound so only for the sparse path, where r × (2m + k) products would dominate)
+LAW_SCALAR_BLOCKS = 4
 
 # Relative pivot thresholds of the L D Lᵀ factorizations: a pivot below RTOL·max|diag|
 # reports a singular matrix instead of producing huge or NaN multipliers.
@@ -102,6 +114,24 @@ def _gram_lower(fq, hv, Y, S, m, rows, n):
                 s = fma(fij, Y[j, c], s)
             S[i, c] = s
 
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def _diagonal_inverse(Mw, n):
+    """``M[j, j] ← 1 / M[j, j]`` for a diagonal mass matrix; whether a pivot fails the test
+    of :func:`.linalg.ldl_inplace` (the same numbers as its factor of a diagonal M)."""
+    dmax = abs(Mw[0, 0])
+    for i in range(1, n):
+        dmax = max(dmax, abs(Mw[i, i]))
+    tol = MASS_RTOL * dmax
+    bad = False
+    for j in range(n):
+        d = Mw[j, j]
+        bad |= not (d > tol)
+        Mw[j, j] = 1.0 / d
+    return bad
+
+
+_NO_INDEX = np.zeros(1, dtype=np.int64)
 
 Kernels = namedtuple(
     "Kernels", "rhs residual energy project make_workspace stack_workspace n m k ng key"
@@ -167,6 +197,54 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     # symbol name shared by every model's "energy" (see _cache.tag)
     energy_fn = _rejit(model.energy, _nan_energy)
     make_workspace, stack_workspace = builders(n, m, k)
+    # The sparse path (:mod:`.sparsity`) where the model's structure pays for it; not for
+    # the least-squares multiplier or the correction of Ascher et al., which stay dense.
+    st = None if (lstsq or law_code == LAW_ACPR) else model.sparse_structure()
+    SPARSE = st is not None
+    if SPARSE:
+        FPTR, FCOL, CPTR, CROW = st.fptr, st.fcol, st.cptr, st.crow
+        HQPTR, HQCOL = st.hqptr, st.hqcol
+        SI, SC, SPTR, SJ = st.si, st.sc, st.sptr, st.sj
+        LPTR, LCOL, OPTR, OQ, LTPTR, LROW = st.lptr, st.lcol, st.optr, st.oq, st.ltptr, st.lrow
+    else:  # never read (the branches on SPARSE are pruned), but typed
+        FPTR = FCOL = CPTR = CROW = HQPTR = HQCOL = SI = SC = SPTR = SJ = _NO_INDEX
+        LPTR = LCOL = OPTR = OQ = LTPTR = LROW = _NO_INDEX
+
+    @njit(forceinline=True, error_model="numpy")
+    def sparse_Y(t, q, p, ws, rows):
+        """The sparse path's ``Y = M⁻¹ Fᵀ`` for the first ``rows`` rows of ``F`` (M
+        diagonal, its inverse left on the diagonal of ``ws.M``, or absent); whether M's
+        test failed."""
+        fq, hv, Y, Mw = ws.fq, ws.hv, ws.Y, ws.M
+        bad = False
+        if HAS_MASS:
+            mass(t, q, p, Mw)
+            bad = _diagonal_inverse(Mw, n)
+        for j in range(n):
+            for e in range(CPTR[j], CPTR[j + 1]):
+                i = CROW[e]
+                if i < rows:
+                    fij = fq[i, j] if i < m else hv[i - m, j]
+                    Y[j, i] = fij * Mw[j, j] if HAS_MASS else fij
+        return bad
+
+    @njit(forceinline=True, error_model="numpy")
+    def sparse_S(ws, rows):
+        """The sparse path's ``S = F Y`` on its factor's pattern (the fill starts from
+        zero) and its L D Lᵀ factor, for the first ``rows`` rows of F (the leading block's
+        fill is the leading block of the fill); whether a pivot failed."""
+        fq, hv, Y, S = ws.fq, ws.hv, ws.Y, ws.S
+        for e in range(SI.shape[0]):
+            i = SI[e]
+            c = SC[e]
+            if i < rows:
+                s = -0.0
+                for o in range(SPTR[e], SPTR[e + 1]):
+                    j = SJ[o]
+                    fij = fq[i, j] if i < m else hv[i - m, j]
+                    s = fma(fij, Y[j, c], s)
+                S[i, c] = s
+        return ldl_sparse_inplace(S, rows, S_RTOL, LPTR, LCOL, OPTR, OQ) != 0
 
     @njit(forceinline=True)
     def residual(t, x, p, ws, g):
@@ -184,8 +262,13 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 f_t(t, q, p, sm)
             for i in range(m):
                 s = sm[i] if HAS_FT else -0.0
-                for j in range(n):
-                    s = fma(fq[i, j], v[j], s)
+                if SPARSE:
+                    for e in range(FPTR[i], FPTR[i + 1]):
+                        j = FCOL[e]
+                        s = fma(fq[i, j], v[j], s)
+                else:
+                    for j in range(n):
+                        s = fma(fq[i, j], v[j], s)
                 g[m + i] = s
         if k > 0:
             h_fn(t, q, v, p, sk)
@@ -219,8 +302,13 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 h_t(t, q, v, p, sk)
             for i in range(k):
                 s = -sk[i] if HAS_HT else -0.0
-                for j in range(n):
-                    s = fma(-hq[i, j], v[j], s)
+                if SPARSE:
+                    for e in range(HQPTR[i], HQPTR[i + 1]):
+                        j = HQCOL[e]
+                        s = fma(-hq[i, j], v[j], s)
+                else:
+                    for j in range(n):
+                        s = fma(-hq[i, j], v[j], s)
                 rl[m + i] = s
         if LAW == LAW_CONSTANT:
             for i in range(r):
@@ -228,6 +316,12 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 for j in range(ng):
                     s = fma(law_mat[i, j], g[j], s)
                 rl[i] = s
+        elif LAW == LAW_SCALAR_BLOCKS:
+            for i in range(m):
+                s = fma(law_mat[0, 0], g[i], rl[i])
+                rl[i] = fma(law_mat[0, 1], g[m + i], s)
+            for i in range(k):
+                rl[m + i] = fma(law_mat[0, 2], g[2 * m + i], rl[m + i])
         elif LAW == LAW_USER:
             law_A(t, x, p, Aw)
             for i in range(r):
@@ -255,36 +349,60 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         # (LAW_ACPR: the index-1 equations, A g = 0; its correction is added at the end)
 
         # Y = M⁻¹ Fᵀ and z = M⁻¹ γ
-        _load_Ft(fq, hv, Y, m, r, n)
         # No early returns below: a failed factorization is remembered and reported at the
         # end, so that the ensemble kernel can inline this body into a vectorized loop.
         bad_mass = False
-        if HAS_MASS:
-            mass(t, q, p, Mw)
-            bad_mass = ldl_inplace(Mw, n, MASS_RTOL) != 0
-            ldl_solve_columns(Mw, n, Y, r)
-            ldl_solve_inplace(Mw, n, z)
-
-        # rl += F z, and S = F Y (symmetric; the lower triangle suffices for L D Lᵀ)
-        for i in range(r):
-            s = rl[i]
+        if SPARSE:
+            # M diagonal or absent: Y has Fᵀ's pattern; only its non-zeros are written,
+            # and only they are read
+            bad_mass = sparse_Y(t, q, p, ws, r)
+            if HAS_MASS:
+                for j in range(n):
+                    z[j] *= Mw[j, j]
+            for i in range(r):  # rl += F z
+                s = rl[i]
+                for e in range(FPTR[i], FPTR[i + 1]):
+                    j = FCOL[e]
+                    fij = fq[i, j] if i < m else hv[i - m, j]
+                    s = fma(fij, z[j], s)
+                rl[i] = s
+            bad_S = sparse_S(ws, r)
+            ldl_sparse_solve(S, r, rl, LPTR, LCOL, LTPTR, LROW)  # rl is now λ
             for j in range(n):
-                fij = fq[i, j] if i < m else hv[i - m, j]
-                s = fma(fij, z[j], s)
-            rl[i] = s
-        _gram_lower(fq, hv, Y, S, m, r, n)
-        if LSTSQ:  # redundant constraints: the minimum-norm least-squares λ
-            bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws.V, ws.ev, ws.mu) == 0
+                s = -z[j]
+                for e in range(CPTR[j], CPTR[j + 1]):
+                    i = CROW[e]
+                    s = fma(Y[j, i], rl[i], s)
+                xdot[j] = v[j]
+                xdot[n + j] = s
         else:
-            bad_S = ldl_inplace(S, r, S_RTOL) != 0
-            ldl_solve_inplace(S, r, rl)  # rl is now λ
+            _load_Ft(fq, hv, Y, m, r, n)
+            if HAS_MASS:
+                mass(t, q, p, Mw)
+                bad_mass = ldl_inplace(Mw, n, MASS_RTOL) != 0
+                ldl_solve_columns(Mw, n, Y, r)
+                ldl_solve_inplace(Mw, n, z)
 
-        for j in range(n):
-            s = -z[j]
+            # rl += F z, and S = F Y (symmetric; the lower triangle suffices for L D Lᵀ)
             for i in range(r):
-                s = fma(Y[j, i], rl[i], s)
-            xdot[j] = v[j]
-            xdot[n + j] = s
+                s = rl[i]
+                for j in range(n):
+                    fij = fq[i, j] if i < m else hv[i - m, j]
+                    s = fma(fij, z[j], s)
+                rl[i] = s
+            _gram_lower(fq, hv, Y, S, m, r, n)
+            if LSTSQ:  # redundant constraints: the minimum-norm least-squares λ
+                bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws.V, ws.ev, ws.mu) == 0
+            else:
+                bad_S = ldl_inplace(S, r, S_RTOL) != 0
+                ldl_solve_inplace(S, r, rl)  # rl is now λ
+
+            for j in range(n):
+                s = -z[j]
+                for i in range(r):
+                    s = fma(Y[j, i], rl[i], s)
+                xdot[j] = v[j]
+                xdot[n + j] = s
         if LAW == LAW_ACPR:
             # − γ_s (δq, δv): δv = Y S⁻¹ (ḟ, h); δq = Y₁ P⁻¹ f with P = f_q M⁻¹ f_qᵀ the
             # leading m × m block of S, whose L D Lᵀ factor is the leading block of S's
@@ -340,6 +458,23 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 if err <= tol or err > 0.5 * prev:  # converged, or at the roundoff level
                     break
                 prev = err
+                rhs_ = sm if level == 0 else mu
+                for i in range(cols):
+                    rhs_[i] = g[lo + i]
+                if SPARSE:
+                    if sparse_Y(t, q, p, ws, cols):
+                        return _MASS_NOT_SPD
+                    if sparse_S(ws, cols):
+                        return _SINGULAR_S
+                    ldl_sparse_solve(S, cols, rhs_, LPTR, LCOL, LTPTR, LROW)
+                    for j in range(n):
+                        s = -0.0
+                        for e in range(CPTR[j], CPTR[j + 1]):
+                            i = CROW[e]
+                            if i < cols:
+                                s = fma(Y[j, i], rhs_[i], s)
+                        x[level * n + j] -= s
+                    continue
                 _load_Ft(fq, hv, Y, m, cols, n)
                 if HAS_MASS:
                     mass(t, q, p, Mw)
@@ -349,9 +484,6 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 _gram_lower(fq, hv, Y, S, m, cols, n)
                 if ldl_inplace(S, cols, S_RTOL) != 0:
                     return _SINGULAR_S
-                rhs_ = sm if level == 0 else mu
-                for i in range(cols):
-                    rhs_[i] = g[lo + i]
                 ldl_solve_inplace(S, cols, rhs_)
                 for j in range(n):
                     s = -0.0
@@ -369,7 +501,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         return energy_fn(t, q, v, p)
 
     key = fingerprint(
-        "kernels", n, m, k,
+        "kernels", n, m, k, model.structure_key() if SPARSE else "dense",
         tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
         optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
         *(("lstsq",) if lstsq else ()),

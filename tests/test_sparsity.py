@@ -1,0 +1,195 @@
+"""Structural sparsity: patterns found at construction, declared patterns checked, and the
+sparse right-hand side against the dense one."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numba import njit
+
+import stabdae
+from conftest import KERNELS, SCENES, load_scene, perturbed_state
+from stabdae._laws import bind_law
+from stabdae.kernels.rhs import LAW_CONSTANT, LAW_SCALAR_BLOCKS, kernels_for
+from stabdae.kernels.sparsity import fill_pattern, structure
+
+
+def _rhs_and_projection(model, law, x, t=0.05):
+    """ẋ at ``x`` and ``x`` after one full projection, through the compiled pieces."""
+    bound = bind_law(law, model)
+    K = kernels_for(model, bound)
+    ws, p = K.make_workspace(), model.param_vector()
+    out = np.empty_like(x)
+    status = K.rhs(t, x, p, bound.matrix, bound.scalars, ws, out)
+    y = x.copy()
+    # (the redundant four-bar's position level is singular: both paths say so)
+    projected = K.project(t, y, p, ws, 8, 0.0)
+    return (status, out), (projected, y if projected == 0 else None)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_sparse_and_dense_paths_agree_on_every_scene(name):
+    """The sparse path does the dense path's arithmetic minus the structurally zero terms:
+    the same numbers up to the sign of a zero, for the right-hand side and the
+    projection, at states off the manifold."""
+    model = load_scene(name)
+    sparse = model.replace(sparsity="sparse")
+    if sparse.sparse_structure() is None:  # a mass matrix that is not diagonal
+        assert model.has_mass and (model.patterns["mass"] & ~np.eye(model.n, dtype=bool)).any()
+        pytest.skip("the mass matrix is not diagonal: dense path only")
+    # (the scene itself where it takes the dense path: its kernels may be compiled already)
+    dense = model if model.sparse_structure() is None else model.replace(sparsity="dense")
+    assert dense.sparse_structure() is None
+    law = stabdae.baumgarte(omega=6.0, xi=0.8, k=4.0)
+    # Baumgarte's blocks are multiples of the identity: the sparse path applies A by its
+    # three factors, the dense one by the full matrix
+    assert bind_law(law, sparse).code == LAW_SCALAR_BLOCKS
+    assert bind_law(law, dense).code == LAW_CONSTANT
+    for seed in range(3):
+        x = perturbed_state(model, 1e-2, seed)
+        (a, pa), (b, pb) = _rhs_and_projection(sparse, law, x), _rhs_and_projection(dense, law, x)
+        assert a[0] == b[0] == 0 and pa[0] == pb[0]
+        np.testing.assert_array_equal(a[1], b[1])
+        np.testing.assert_array_equal(pa[1], pb[1])
+
+
+def test_fekete_uses_the_sparse_path_and_matches_a_direct_evaluation():
+    """Fekete's S is diagonal: no product between two charges, no fill; the stabilized
+    acceleration equals the closed form of one charge, v̇_i = −γ_i + 2 λ_i p_i with
+    λ_i from the scalar equation of its own constraint."""
+    model = stabdae.load_model(KERNELS / "fekete.py")
+    st = model.sparse_structure()
+    assert st is not None
+    assert (st.nnz_f, st.nnz_s, st.nnz_l) == (60, 20, 0)
+    assert st.sj.size == 60 and st.oq.size == 0
+    omega, xi = 10.0, 1.0
+    law = stabdae.baumgarte(omega, xi)
+    x = perturbed_state(model, 1e-3, 1)
+    (status, xdot), _ = _rhs_and_projection(model, law, x, t=0.0)
+    assert status == 0
+    n, N = model.n, model.n // 3
+    q, v = x[:n].reshape(N, 3), x[n:].reshape(N, 3)
+    gamma = model.evaluate("forces", 0.0, x).reshape(N, 3)
+    f = (q * q).sum(1) - 1.0
+    fdot = 2.0 * (q * v).sum(1)
+    accel = 2.0 * (v * v).sum(1)  # f̈ = 2 q·v̇ + 2|v|² = ω² (−f) … the law: f̈ = −ω² f − 2ξω ḟ
+    target = -omega**2 * f - 2 * xi * omega * fdot
+    # v̇ = 2 λ q − γ, so f̈ = 2 q·(2 λ q − γ) + accel: λ = (target − accel + 2 q·γ) / (4|q|²)
+    lam = (target - accel + 2 * (q * gamma).sum(1)) / (4 * (q * q).sum(1))
+    expected = 2 * lam[:, None] * q - gamma
+    np.testing.assert_allclose(xdot[n:].reshape(N, 3), expected, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(xdot[:n], x[n:])
+
+
+def test_fill_of_an_arrow_matrix_and_of_a_band():
+    """The factor's pattern: an arrow pointing up-left fills completely, one pointing
+    down-right not at all; a band keeps its width."""
+    r = 5
+    up = np.eye(r, dtype=bool)
+    up[:, 0] = up[0, :] = True
+    assert fill_pattern(up).sum() == r * (r + 1) // 2
+    down = np.eye(r, dtype=bool)
+    down[:, -1] = down[-1, :] = True
+    np.testing.assert_array_equal(fill_pattern(down), np.tril(down))
+    band = np.abs(np.subtract.outer(np.arange(r), np.arange(r))) <= 1
+    np.testing.assert_array_equal(fill_pattern(band), np.tril(band))
+
+
+def test_chain_structure_is_banded():
+    """A chain of links, each constraint touching its own point and the one before: S is
+    tridiagonal, its factor has no fill, and each entry is made of the products of the
+    shared coordinates only."""
+    N = 6
+    F = np.zeros((N, 2 * N), dtype=bool)
+    for i in range(N):
+        F[i, 2 * i: 2 * i + 2] = True
+        if i:
+            F[i, 2 * i - 2: 2 * i] = True
+    st = structure(F)
+    assert st.nnz_s == N + (N - 1)
+    assert st.nnz_l == N - 1 and st.oq.size == 0
+    assert st.sj.size == 2 + 4 * (N - 1) + 2 * (N - 1)  # S00, S_ii (4 terms), S_i,i-1 (2)
+
+
+# --------------------------------------------------------------------- detection, declared
+@njit
+def _forces(t, q, v, p, out):
+    for i in range(q.shape[0]):
+        out[i] = 0.0
+    out[1] = 1.0
+
+
+@njit
+def _f(t, q, p, out):
+    out[0] = q[0] ** 2 + q[1] ** 2 - 1.0
+    out[1] = q[2] - q[0] * q[0] * q[0]
+
+
+@njit
+def _f_q(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+    out[0, 2] = 0.0
+    out[1, 0] = -3.0 * q[0] * q[0]
+    out[1, 1] = 0.0
+    out[1, 2] = 1.0
+
+
+@njit
+def _f_accel(t, q, v, p, out):
+    out[0] = 2.0 * (v[0] ** 2 + v[1] ** 2)
+    out[1] = -6.0 * q[0] * v[0] * v[0]
+
+
+def _bead(**kwargs):
+    """A point on the unit circle (x, y) with a third coordinate z = x³; at the reference
+    state x = 0, so ∂f₁/∂x = −3x² is zero there and non-zero elsewhere."""
+    return stabdae.Model("bead", n=3, m=2, reference_state=np.array([0.0, 1.0, 0.0, 0, 0, 0]),
+                         forces=_forces, f=_f, f_q=_f_q, f_accel=_f_accel, **kwargs)
+
+
+def test_detection_sees_entries_that_vanish_at_the_reference_state():
+    model = _bead()
+    expected = np.array([[True, True, False], [True, False, True]])
+    np.testing.assert_array_equal(model.patterns["f_q"], expected)
+    assert _bead(sparsity="dense").patterns is None
+
+
+def test_a_wrongly_declared_pattern_is_caught_by_check():
+    """An entry declared structurally zero that is zero at the reference state only: the
+    model is built, and check() names the function and the entry."""
+    wrong = np.array([[True, True, False], [False, False, True]])  # misses ∂f₁/∂x
+    model = _bead(sparsity={"f_q": wrong})
+    np.testing.assert_array_equal(model.patterns["f_q"], wrong)
+    report = model.check()
+    assert not report.ok
+    assert "sparsity" in report.failures
+    text = str(report)
+    assert "f_q" in text and "out[1, 0]" in text and "structurally zero" in text
+    assert _bead(sparsity={"f_q": model.patterns["f_q"] | True}).check().ok
+
+
+def test_a_declared_pattern_wrong_at_the_reference_state_is_refused_at_once():
+    wrong = np.array([[True, False, False], [True, False, True]])  # misses ∂f₀/∂y, = 2 there
+    with pytest.raises(stabdae.ModelError, match=r"f_q\(t, q, p, out\) writes out\[0, 1\]"):
+        _bead(sparsity={"f_q": wrong})
+
+
+@pytest.mark.parametrize(
+    "sparsity, match",
+    [("fast", "sparsity must be 'detect', 'dense', 'sparse' or a mapping"),
+     ({"h_v": np.ones((2, 3))}, "not one of the model's pieces"),
+     ({"f_q": np.ones((3, 2))}, r"shape of out, \(2, 3\), got \(3, 2\)"),
+     (3, "got int")],
+)  # fmt: skip
+def test_bad_sparsity_arguments_name_what_is_wrong(sparsity, match):
+    with pytest.raises(stabdae.ModelError, match=match):
+        _bead(sparsity=sparsity)
+
+
+def test_replace_keeps_the_pieces_and_refuses_unknown_arguments():
+    model = _bead()
+    other = model.replace(name="bead2")
+    assert other.name == "bead2" and other.functions == model.functions
+    with pytest.raises(stabdae.ModelError, match=r"Model.replace: \['colour'\]"):
+        model.replace(colour="red")
