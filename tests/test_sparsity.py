@@ -18,7 +18,9 @@ def _rhs_and_projection(model, law, x, t=0.05):
     """ẋ at ``x`` and ``x`` after one full projection, through the compiled pieces."""
     bound = bind_law(law, model)
     K = kernels_for(model, bound)
-    ws, p = K.make_workspace(), model.param_vector()
+    # parameters away from their defaults (unit masses would hide a forgotten M⁻¹)
+    p = model.param_vector() * np.linspace(1.1, 1.5, len(model.params))
+    ws = K.make_workspace()
     out = np.empty_like(x)
     status = K.rhs(t, x, p, bound.matrix, bound.scalars, ws, out)
     y = x.copy()
@@ -69,7 +71,7 @@ def test_fekete_uses_the_sparse_path_and_matches_a_direct_evaluation():
     assert status == 0
     n, N = model.n, model.n // 3
     q, v = x[:n].reshape(N, 3), x[n:].reshape(N, 3)
-    gamma = model.evaluate("forces", 0.0, x).reshape(N, 3)
+    gamma = model.evaluate("forces", 0.0, x, model.param_vector() * 1.1).reshape(N, 3)
     f = (q * q).sum(1) - 1.0
     fdot = 2.0 * (q * v).sum(1)
     accel = 2.0 * (v * v).sum(1)  # f̈ = 2 q·v̇ + 2|v|² = ω² (−f) … the law: f̈ = −ω² f − 2ξω ḟ

@@ -96,6 +96,14 @@ class Model:
         when absent), ``f_t``, ``h_t`` (scleronomic when absent) and ``energy`` are optional.
     t0 : float, default 0.0
         Time at which ``reference_state`` is consistent.
+    sparsity : {"detect", "sparse", "dense"} or mapping, default "detect"
+        The structural zeros of ``mass``, ``f_q``, ``h_q`` and ``h_v``: found by
+        evaluating them at the reference state and four random states (``"detect"``; the
+        sparse right-hand side is used where it saves at least half the work and the mass
+        matrix is diagonal or absent), found and always used (``"sparse"``), or none
+        (``"dense"``).  A mapping declares patterns (boolean arrays of ``out``'s shape)
+        for some pieces; the others are found.  ``model.patterns`` holds them,
+        :meth:`check` verifies them.
 
     Raises
     ------
