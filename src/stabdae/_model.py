@@ -20,6 +20,7 @@ energy      ``energy(t, q, v, p)``       float     optional, for drift diagnosti
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable, Mapping, Sequence
 
@@ -49,6 +50,7 @@ _PIECES: dict[str, tuple[str, Callable[[int, int, int], tuple[int, ...]], str]] 
     "h_v": ("tqvp", lambda n, m, k: (k, n), "k, n"),
     "h_t": ("tqvp", lambda n, m, k: (k,), "k"),
 }
+_UNSET = object()
 #: pieces whose structural zeros the sparse right-hand side uses
 _PATTERNED = ("mass", "f_q", "h_q", "h_v")
 _HOLONOMIC = ("f", "f_q", "f_t", "f_accel")
@@ -191,6 +193,7 @@ class Model:
         outputs = self._probe_all(x_ref, p)
         self._check_consistent(x_ref, p)
         self.patterns = self._sparsity(sparsity, x_ref, p, outputs)
+        self._structure = _UNSET  # sparse_structure(), made when first asked for
         self._kernel_cache: dict = {}
 
     # ----------------------------------------------------------------- properties
@@ -469,12 +472,14 @@ class Model:
         self._sparsity_mode = "detect"
         self._declared: tuple[str, ...] = ()
         declared = {}
+        named = isinstance(sparsity, str) and sparsity in ("detect", "dense", "sparse")
+        if not (named or isinstance(sparsity, Mapping)):
+            got = repr(sparsity) if isinstance(sparsity, str) else type(sparsity).__name__
+            raise ModelError(
+                f"Model {self.name!r}: sparsity must be 'detect', 'dense', 'sparse' or a "
+                f"mapping of {list(_PATTERNED)} to boolean arrays, got {got}"
+            )
         if isinstance(sparsity, str):
-            if sparsity not in ("detect", "dense", "sparse"):
-                raise ModelError(
-                    f"Model {self.name!r}: sparsity must be 'detect', 'dense', 'sparse' or a "
-                    f"mapping of {list(_PATTERNED)} to boolean arrays, got {sparsity!r}"
-                )
             if sparsity == "dense":
                 self._sparsity_mode = "dense"
                 return None
@@ -495,12 +500,6 @@ class Model:
                         f"must have the shape of out, {shape}, got {arr.shape}"
                     )
                 declared[piece] = arr.astype(bool)
-        else:
-            raise ModelError(
-                f"Model {self.name!r}: sparsity must be 'detect', 'dense', 'sparse' or a "
-                f"mapping of {list(_PATTERNED)} to boolean arrays, got "
-                f"{type(sparsity).__name__}"
-            )
         patterns = self._detect(x_ref, p)
         for piece, pattern in declared.items():
             outside = (outputs[piece] != 0) & ~pattern
@@ -543,7 +542,7 @@ class Model:
         or None where the dense one is used: ``sparsity="dense"``, a mass matrix that is
         not diagonal, or (``sparsity="detect"`` or declared patterns) a structure that
         saves less than half the dense path's multiply-adds."""
-        if getattr(self, "_structure", False) is not False:
+        if self._structure is not _UNSET:
             return self._structure
         from .kernels.sparsity import dense_cost, sparse_cost, structure
 
@@ -566,8 +565,6 @@ class Model:
 
     def structure_key(self) -> str:
         """What the compiled sparse right-hand side depends on: the patterns."""
-        import hashlib
-
         h = hashlib.sha1()
         for piece in _PATTERNED:
             if self.patterns is not None and piece in self.patterns:

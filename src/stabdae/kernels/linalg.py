@@ -25,6 +25,16 @@ from .fma import fma
 
 
 @njit(cache=True, error_model="numpy", forceinline=True)
+def pivot_tolerance(a, n, rtol):
+    """``rtol · max_i |a_ii|`` over the leading ``n × n`` block: the smallest pivot the
+    factorizations accept."""
+    dmax = abs(a[0, 0])  # (n = 0 reads a spare entry that is never used)
+    for i in range(1, n):
+        dmax = max(dmax, abs(a[i, i]))
+    return rtol * dmax
+
+
+@njit(cache=True, error_model="numpy", forceinline=True)
 def ldl_inplace(a, n, rtol):
     """``a[:n, :n] = L D Lᵀ`` in place, for a symmetric positive definite matrix.
 
@@ -49,10 +59,7 @@ def ldl_inplace(a, n, rtol):
         ``0`` on success, otherwise ``j + 1`` for the first failing pivot ``j`` (the
         factor is then garbage and must not be used).
     """
-    dmax = abs(a[0, 0])  # (n = 0 reads a spare entry that is never used)
-    for i in range(1, n):
-        dmax = max(dmax, abs(a[i, i]))
-    tol = rtol * dmax
+    tol = pivot_tolerance(a, n, rtol)
     fail = 0
     for j in range(n):
         # row j: first w_p = L_jp d_p = a_jp − Σ_{q<p} w_q L_pq (rows p < j are final) …
@@ -200,10 +207,7 @@ def ldl_sparse_inplace(a, n, rtol, lptr, lcol, optr, oq):
     ``oq[optr[e]:optr[e+1]]``.  The same operations in the same order as the dense
     factorization without its structurally zero terms; entries off the pattern are neither
     read nor written (the fill must hold zeros on entry)."""
-    dmax = abs(a[0, 0])
-    for i in range(1, n):
-        dmax = max(dmax, abs(a[i, i]))
-    tol = rtol * dmax
+    tol = pivot_tolerance(a, n, rtol)
     fail = 0
     for j in range(n):
         for e in range(lptr[j], lptr[j + 1]):

@@ -47,6 +47,7 @@ from .linalg import (
     ldl_sparse_inplace,
     ldl_sparse_solve,
     pinv_solve_sym,
+    pivot_tolerance,
 )
 from .workspace import builders
 
@@ -119,10 +120,7 @@ def _gram_lower(fq, hv, Y, S, m, rows, n):
 def _diagonal_inverse(Mw, n):
     """``M[j, j] ← 1 / M[j, j]`` for a diagonal mass matrix; whether a pivot fails the test
     of :func:`.linalg.ldl_inplace` (the same numbers as its factor of a diagonal M)."""
-    dmax = abs(Mw[0, 0])
-    for i in range(1, n):
-        dmax = max(dmax, abs(Mw[i, i]))
-    tol = MASS_RTOL * dmax
+    tol = pivot_tolerance(Mw, n, MASS_RTOL)
     bad = False
     for j in range(n):
         d = Mw[j, j]
