@@ -308,12 +308,13 @@ def test_every_tableau_pattern_equals_single_integrations(spec):
                                       one.residual_norm.values.astype(np.float32))  # fmt: skip
 
 
-@pytest.mark.parametrize("spec", ["euler", "midpoint", "heun", "rk4", "dopri5", (0.3, 0.0),
-                                  (0.25, 2.0)])
-def test_time_dependent_model_every_tableau_pattern_equals_single_integrations(spec):
+@pytest.mark.parametrize("spec", ["rk4", "dopri5"])
+def test_time_dependent_model_stage_times_equal_single_integrations(spec):
     """On time-dependent constraints (the pendulum of prescribed length, the car axis) the
     stage times t + c·τ matter: the ensemble kernel's generated step gives the numbers of
-    ``integrate`` bit for bit for every pattern of coefficients."""
+    ``integrate`` bit for bit.  The stage times are formed alike for every pattern of
+    coefficients (the patterns themselves are covered on the pendulum above); RK4 repeats
+    a stage time, dopri5 has seven distinct ones and zeros inside A."""
     scheme = _scheme(spec)
     cases = [("pendulum_varying_length", stabdae.baumgarte(10.0, 1.0), 2e-3)]
     if spec == "rk4":  # (one pattern on the car axis: each pattern is a compilation)
