@@ -1,4 +1,4 @@
-"""Throughput and compile time against model size: the Fekete problem with N charges.
+"""Throughput and compile time against model size: Fekete's N charges, a chain of N pendulums.
 
 Fekete's N constraints ``|p_i|² = 1`` touch three coordinates each, so S = F M⁻¹ Fᵀ is
 diagonal and the stabilized right-hand side's constraint part is N scalar divisions; its
@@ -8,8 +8,13 @@ hand in Numba for this model alone: one member per thread, the stabilized accele
 in closed form (v̇_i = 2 λ_i p_i − γ_i, λ_i from the charge's own scalar equation), the
 same midpoint steps.  Both start from the same states; their final states are compared.
 
-    python studies/bench_scaling.py                 # N = 5, 10, 20, 40
+The chain of N planar pendulums (``kernels/pendulum_chain.py``: n = 2N, m = N, unit
+masses) couples neighbouring constraints: S is tridiagonal and its factor has no fill.  It
+has no kernel written by hand; ``--dense`` sets the dense right-hand side beside it.
+
+    python studies/bench_scaling.py                 # Fekete, N = 5, 10, 20, 40
     python studies/bench_scaling.py --N 20 --members 4096 --dense
+    python studies/bench_scaling.py --model chain --N 4 8 16 32 64 --dense
 
 Compile time is the first ensemble of each model in this process (the library's own
 functions, shared by every model, come from the kernel cache after the first).
@@ -83,24 +88,29 @@ def hand_midpoint(x0s, tau, nsteps, a, omega, xi, out):
         out[i] = x
 
 
-def fekete(N: int, sparsity: str = "detect") -> stabdae.Model:
-    base = stabdae.load_model(HERE.parent / "kernels" / "fekete.py")
+FILES = {"fekete": "fekete.py", "chain": "pendulum_chain.py"}
+
+
+def build(name: str, N: int, sparsity: str = "detect") -> stabdae.Model:
+    """The model ``name`` (a key of :data:`FILES`) of size ``N``."""
     import sys
 
     from stabdae._loading import module_name
 
-    module = sys.modules[module_name(HERE.parent / "kernels" / "fekete.py")]
-    model = module.build(N) if N != base.n // 3 else base
+    path = HERE.parent / "kernels" / FILES[name]
+    base = stabdae.load_model(path)
+    model = sys.modules[module_name(path)].build(N) if N != base.m else base
     return model if sparsity == "detect" else model.replace(sparsity=sparsity)
 
 
-def measure(N: int, members: int, t_end: float, repeats: int, dense: bool) -> list[dict]:
+def measure(name: str, N: int, members: int, t_end: float, repeats: int,
+            dense: bool) -> list[dict]:  # fmt: skip
     tau, omega, xi = 0.01, 10.0, 1.0
     law = stabdae.baumgarte(omega, xi)
     nsteps = round(t_end / tau)
     rows = []
     for kind in ("sparse", "dense") if dense else ("sparse",):
-        model = fekete(N, "detect" if kind == "sparse" else "dense")
+        model = build(name, N, "detect" if kind == "sparse" else "dense")
         assert (model.sparse_structure() is not None) == (kind == "sparse")
         clock = time.perf_counter()
         stabdae.ensemble(model, law, "midpoint", tau, 2 * tau, members=8, radius=(1e-6, 1e-5),
@@ -111,9 +121,13 @@ def measure(N: int, members: int, t_end: float, repeats: int, dense: bool) -> li
             ds = stabdae.ensemble(model, law, "midpoint", tau, t_end, members=members,
                                   radius=(1e-6, 1e-4), seed=1, traces=0)  # fmt: skip
             best = min(best, ds.attrs["wall_integrate_s"])
-        rows.append(dict(N=N, kind=kind, compile_s=compile_s, wall_s=best,
+        rows.append(dict(N=N, n=model.n, kind=kind, compile_s=compile_s, wall_s=best,
                          rate=members * nsteps / best, x0=ds.x0.values,
                          x_final=ds.x_final.values))  # fmt: skip
+    if name != "fekete":  # no hand-written kernel: the paths against each other
+        for row in rows[1:]:
+            row["diff"] = float(np.max(np.abs(row["x_final"] - rows[0]["x_final"])))
+        return rows
     x0 = np.ascontiguousarray(rows[0]["x0"])
     out = np.empty_like(x0)
     clock = time.perf_counter()
@@ -124,31 +138,35 @@ def measure(N: int, members: int, t_end: float, repeats: int, dense: bool) -> li
         clock = time.perf_counter()
         hand_midpoint(x0, tau, nsteps, 0.5, omega, xi, out)
         best = min(best, time.perf_counter() - clock)
-    diff = float(np.max(np.abs(out - rows[0]["x_final"])))
-    rows.append(dict(N=N, kind="hand", compile_s=hand_compile, wall_s=best,
-                     rate=members * nsteps / best, diff=diff))  # fmt: skip
+    for row in rows:
+        row["diff"] = float(np.max(np.abs(out - row["x_final"])))
+    rows.append(dict(N=N, n=model.n, kind="hand", compile_s=hand_compile, wall_s=best,
+                     rate=members * nsteps / best))  # fmt: skip
     return rows
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--model", choices=sorted(FILES), default="fekete")
     parser.add_argument("--N", type=int, nargs="+", default=[5, 10, 20, 40])
     parser.add_argument("--members", type=int, default=4096)
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--dense", action="store_true", help="also the dense right-hand side")
     args = parser.parse_args()
-    print(f"# {platform.processor() or platform.machine()}, {get_num_threads()} threads, "
-          f"{args.members} members, {args.t_end} s, midpoint τ = 0.01, Baumgarte ω = 10, ξ = 1")
+    print(f"# {args.model}, {platform.processor() or platform.machine()}, "
+          f"{get_num_threads()} threads, {args.members} members, {args.t_end} s, "
+          "midpoint τ = 0.01, Baumgarte ω = 10, ξ = 1")  # fmt: skip
+    against = "hand" if args.model == "fekete" else "sparse"
     print(f"{'N':>4} {'n':>4} {'path':>7} {'first (s)':>10} {'member-steps/s':>15} "
-          f"{'/ hand':>7}  max |Δx_final| vs hand")  # fmt: skip
+          f"{'/ ' + against:>8}  max |Δx_final| vs {against}")  # fmt: skip
     for N in args.N:
-        rows = measure(N, args.members, args.t_end, args.repeats, args.dense)
-        hand = rows[-1]
+        rows = measure(args.model, N, args.members, args.t_end, args.repeats, args.dense)
+        ref = rows[-1] if against == "hand" else rows[0]
         for row in rows:
-            extra = f"{hand['diff']:.1e}" if row["kind"] == "sparse" else ""
-            print(f"{N:>4} {3 * N:>4} {row['kind']:>7} {row['compile_s']:>10.2f} "
-                  f"{row['rate']:>15.3e} {row['rate'] / hand['rate']:>7.2f}  {extra}")
+            extra = f"{row['diff']:.1e}" if "diff" in row else ""
+            print(f"{N:>4} {row['n']:>4} {row['kind']:>7} {row['compile_s']:>10.2f} "
+                  f"{row['rate']:>15.3e} {row['rate'] / ref['rate']:>8.2f}  {extra}")
 
 
 if __name__ == "__main__":

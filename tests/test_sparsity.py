@@ -8,10 +8,10 @@ import pytest
 from numba import njit
 
 import stabdae
-from conftest import KERNELS, SCENES, load_scene, perturbed_state
+from conftest import KERNELS, SCENES, load_scene, perturbed_state, scene_module
 from stabdae._laws import bind_law
 from stabdae.kernels.rhs import LAW_CONSTANT, LAW_SCALAR_BLOCKS, kernels_for
-from stabdae.kernels.sparsity import fill_pattern, structure
+from stabdae.kernels.sparsity import dense_cost, fill_pattern, sparse_cost, structure
 
 
 def _rhs_and_projection(model, law, x, t=0.05):
@@ -29,7 +29,7 @@ def _rhs_and_projection(model, law, x, t=0.05):
     return (status, out), (projected, y if projected == 0 else None)
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", [*SCENES, "pendulum_chain"])
 def test_sparse_and_dense_paths_agree_on_every_scene(name):
     """The sparse path does the dense path's arithmetic minus the structurally zero terms:
     the same numbers up to the sign of a zero, for the right-hand side and the
@@ -111,6 +111,21 @@ def test_chain_structure_is_banded():
     assert st.nnz_s == N + (N - 1)
     assert st.nnz_l == N - 1 and st.oq.size == 0
     assert st.sj.size == 2 + 4 * (N - 1) + 2 * (N - 1)  # S00, S_ii (4 terms), S_i,i-1 (2)
+
+
+def test_the_pendulum_chain_is_found_tridiagonal():
+    """The chain of N pendulums, detected from its functions: F has the two masses of each
+    rod, S is tridiagonal with no fill, the mass matrix diagonal, so the sparse path is
+    taken; its constraint part's cost grows like N where the dense one grows like N³."""
+    model = load_scene("pendulum_chain")
+    N = model.m
+    st = model.sparse_structure()
+    assert st is not None and model.n == 2 * N
+    assert (st.nnz_f, st.nnz_s, st.nnz_l) == (2 + 4 * (N - 1), 2 * N - 1, N - 1)
+    np.testing.assert_array_equal(model.patterns["mass"], np.eye(model.n, dtype=bool))
+    double = scene_module("pendulum_chain").build(2 * N)
+    assert sparse_cost(double.sparse_structure()) / sparse_cost(st) == pytest.approx(2, rel=0.1)
+    assert dense_cost(4 * N, 2 * N) / dense_cost(2 * N, N) > 6  # (8 for large N)
 
 
 # --------------------------------------------------------------------- detection, declared

@@ -37,7 +37,7 @@ from .kernels.sampler import (
     residual_rows_for,
     sampler_for,
 )
-from .kernels.steps import integrator_for
+from .kernels.steps import residual_trajectory_for
 from .kernels.threads import default_threads, run_chunks
 
 __all__ = ["ensemble", "sample_perturbations"]
@@ -350,13 +350,10 @@ def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps):
     ng = model.n_residual
     if (nsteps + 1) * ng > REFERENCE_MAX_ENTRIES:
         return np.zeros((0, ng))
-    kernel = integrator_for(model, bound, "ldl")
-    out_x = np.empty((nsteps + 1, 2 * model.n))
+    kernel = residual_trajectory_for(model, bound)
     out_g = np.full((nsteps + 1, ng), np.nan)
-    out_e = np.empty(nsteps + 1)
-    status, _ = kernel(model.reference_state(p), t0, tau, nsteps, 1, p, bound.matrix,
-                       bound.scalars, scheme.A, scheme.b, scheme.c, 0, 0.0, out_x, out_g,
-                       out_e)  # fmt: skip
+    status, _ = kernel(model.reference_state(p), t0, tau, nsteps, p, bound.matrix,
+                       bound.scalars, scheme.A, scheme.b, scheme.c, out_g)  # fmt: skip
     if status != 0 or not np.isfinite(out_g).all():
         return np.zeros((0, ng))
     return out_g
