@@ -331,6 +331,25 @@ def test_time_dependent_model_stage_times_equal_single_integrations(spec):
                                           one.residual_norm.values.astype(np.float32))  # fmt: skip
 
 
+def test_reference_residuals_are_those_of_integrate():
+    """Each member's decay is measured on its distance from the residual of the trajectory
+    from the reference state.  Its kernel (the step and the residual alone) gives
+    ``integrate``'s residual at every step bit for bit, sample and stage times included
+    (a time-dependent model: a residual at the wrong time differs at once)."""
+    from stabdae._ensemble import _reference_residuals
+    from stabdae._laws import bind_law
+
+    model = load_scene("pendulum_varying_length")
+    law = stabdae.baumgarte(10.0, 1.0)
+    p, tau, nsteps = model.param_vector(), 2e-3, 50
+    g = _reference_residuals(model, bind_law(law, model), stabdae.rk4(), p, model.t0, tau,
+                             nsteps)  # fmt: skip
+    one = stabdae.integrate(model, model.reference_state(p), law, "rk4", tau,
+                            model.t0 + nsteps * tau, tau)  # fmt: skip
+    assert g.shape == (nsteps + 1, model.n_residual) and np.abs(g[-1]).max() > 0
+    np.testing.assert_array_equal(g, one.residual.values)
+
+
 def test_stability_radius_is_bracketed():
     """Members at known radii 1e-5 … 2e-1 with ε = 1e-3: the three that start above ε are
     not bounded (but stable: they decay), the two below it are; with every member stable

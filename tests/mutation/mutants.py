@@ -86,6 +86,11 @@ MUTANTS = [
            'f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg},',
            'f"    c{s} = rhs(t, {arg},', ("tests/test_ensemble.py",),
            "generated ensemble step drops the stage time c·τ", "time_dependent"),
+    Mutant("reference-residual-time", K + "steps.py",
+           "residual(t0 + i * tau, x, p, ws, out_g[i])",
+           "residual(t0 + (i - 1) * tau, x, p, ws, out_g[i])", ("tests/test_ensemble.py",),
+           "the reference trajectory's residual taken at the step's start time",
+           "reference_residuals"),
     # ---- changes the suite caught before; kept so that it goes on catching them
     Mutant("convective-sign", K + "rhs.py", "                rl[i] = -sm[i]",
            "                rl[i] = sm[i]", ("tests/test_residual_law.py",),
