@@ -2,9 +2,10 @@
 
 ``step`` applies one step of a tableau ``(A, b, c)`` given as run-time arrays (a new
 scheme never recompiles); ``integrate_kernel`` runs it over a trajectory, storing state,
-residual and energy every ``save_every`` steps, and projecting after each step when asked.
-The multiply-adds are fused (:mod:`.fma`) at the same places as in the ensemble kernel's
-generated step (:mod:`.ensemble`), so that both give the same bits.
+residual and energy every ``save_every`` steps, and projecting after each step when asked;
+``residual_kernel`` runs it storing only the residual, at every step.  The multiply-adds
+are fused (:mod:`.fma`) at the same places as in the ensemble kernel's generated step
+(:mod:`.ensemble`), so that both give the same bits.
 """
 
 from __future__ import annotations
@@ -43,9 +44,10 @@ def integrator_for(model, bound, multiplier: str = "ldl"):
 
 def residual_trajectory_for(model, bound):
     """``kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c, out_g)``:
-    the residual at every step of one trajectory, ``(status, steps completed)``; the
-    numbers of :func:`integrator_for`'s loop without projection, saving every step, which
-    also compiles the projection and the energy."""
+    the residual at every step of one trajectory, ``(status, steps completed)``.  The
+    numbers :func:`integrator_for`'s loop gives without projection, saving every step,
+    from a kernel of the step and the residual only (that loop also compiles the
+    projection and the energy): the ensemble's reference trajectory."""
     return stepper_for(model, bound).residuals
 
 
