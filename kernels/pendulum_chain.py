@@ -6,12 +6,12 @@ the rods' lengths:
 
     f_1 = |p_1|² − l²,      f_i = |p_i − p_{i−1}|² − l²   (i = 2 … N).
 
-Each constraint touches the two masses it joins, so F = f_q has four non-zeros per row and
-S = F M⁻¹ Fᵀ is tridiagonal: its L D Lᵀ factor has no fill, and the stabilized right-hand
-side's cost grows like N, not N³.  The model is written for any N (the functions read N
-from their arrays' shapes): ``build(N)`` gives the chain of N masses, ``model`` the one of
-8.  The reference state is the chain stretched straight at 60° from the downward vertical,
-at rest.
+Each constraint touches the two masses it joins (the first only its own), so F = f_q has
+at most four non-zeros per row and S = F M⁻¹ Fᵀ is tridiagonal: its L D Lᵀ factor has no
+fill, and the cost of the stabilized right-hand side's constraint part grows like N, not
+N³.  The model is written for any N (the functions read N from their arrays' shapes):
+``build(N)`` gives the chain of N masses, ``model`` the one of 8.  The reference state is
+the chain stretched straight at 60° from the downward vertical, at rest.
 """
 
 import math
