@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from collections import namedtuple
+from types import SimpleNamespace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -168,18 +169,20 @@ def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kerne
                 lambda: _build(model, bound.code, bound.fn, multiplier == "lstsq"))
 
 
-def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
+def _pieces(model: Model, sparse: bool) -> SimpleNamespace:
+    """The compiled pieces of ``model`` that no law touches: its functions with the
+    library's flags, the workspace, ``residual``, ``project``, ``energy`` (and the sparse
+    path's helpers where ``sparse``), shared by the kernels of every law kind (the sampler
+    and a run under Baumgarte's law compile them once)."""
     # These closures are inlined into the kernels that Python calls (integrate, sample,
     # ensemble); those get an explicit on-disk cache key from :mod:`._cache`.
-    # Compile-time constants of the closure.
+    # Compile-time constants of the closures.
     n, m, k = model.n, model.m, model.k
     r, ng = m + k, 2 * m + k
     fns = model.functions
     HAS_MASS = "mass" in fns
     HAS_FT = "f_t" in fns
     HAS_HT = "h_t" in fns
-    LAW = law_code
-    LSTSQ = lstsq
     mass = _rejit(fns.get("mass"), _noop4)
     forces = _rejit(fns["forces"], None)
     f_fn = _rejit(fns.get("f"), _noop4)
@@ -190,14 +193,11 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     h_q = _rejit(fns.get("h_q"), _noop5)
     h_v = _rejit(fns.get("h_v"), _noop5)
     h_t = _rejit(fns.get("h_t"), _noop5)
-    law_A = _rejit(law_fn, _noop4)
     # inlined like the other pieces: a separately compiled user function would carry a
     # symbol name shared by every model's "energy" (see _cache.tag)
     energy_fn = _rejit(model.energy, _nan_energy)
     make_workspace, stack_workspace = builders(n, m, k)
-    # The sparse path (:mod:`.sparsity`) where the model's structure pays for it; not for
-    # the least-squares multiplier or the correction of Ascher et al., which stay dense.
-    st = None if (lstsq or law_code == LAW_ACPR) else model.sparse_structure()
+    st = model.sparse_structure() if sparse else None
     SPARSE = st is not None
     if SPARSE:
         FPTR, FCOL, CPTR, CROW = st.fptr, st.fcol, st.cptr, st.crow
@@ -274,6 +274,105 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 g[2 * m + i] = sk[i]
             h_v(t, q, v, p, hv)
             h_q(t, q, v, p, hq)
+
+    @njit(error_model="numpy")
+    def project(t, x, p, ws, sweeps, tol):
+        """Move ``x`` onto (towards) the manifold ``g = 0``, in place; return a status.
+
+        Positions first, then velocities at the corrected positions (the block form of
+        ``x ← x − D (G D)⁻¹ g`` of Ascher et al.), each level repeated until its residual
+        max-norm is ``≤ tol``, stops halving (the roundoff level) or ``sweeps``
+        corrections were made::
+
+            q ← q − M⁻¹f_qᵀ (f_q M⁻¹f_qᵀ)⁻¹ f          (Gauss–Newton in the M metric)
+            v ← v − M⁻¹Fᵀ S⁻¹ (ḟ, h)
+
+        One sweep with ``tol = 0`` is post-stabilization; sweeps to a small tolerance are
+        coordinate projection.
+        """
+        Mw, fq, hv, Y, S, g, sm, mu = ws.M, ws.fq, ws.hv, ws.Y, ws.S, ws.g, ws.sm, ws.mu
+        q = ws.q
+        for level in range(2):
+            if (level == 0 and m == 0) or (level == 1 and r == 0):
+                continue
+            lo, cols = (0, m) if level == 0 else (m, r)
+            prev = math.inf
+            for _ in range(sweeps):
+                residual(t, x, p, ws, g)
+                err = 0.0
+                for i in range(cols):
+                    err = max(err, abs(g[lo + i]))
+                if err <= tol or err > 0.5 * prev:  # converged, or at the roundoff level
+                    break
+                prev = err
+                rhs_ = sm if level == 0 else mu
+                for i in range(cols):
+                    rhs_[i] = g[lo + i]
+                if SPARSE:
+                    if sparse_Y(t, q, p, ws, cols):
+                        return _MASS_NOT_SPD
+                    if sparse_S(ws, cols):
+                        return _SINGULAR_S
+                    ldl_sparse_solve(S, cols, rhs_, LPTR, LCOL, LTPTR, LROW)
+                    for j in range(n):
+                        s = -0.0
+                        for e in range(CPTR[j], CPTR[j + 1]):
+                            i = CROW[e]
+                            if i < cols:
+                                s = fma(Y[j, i], rhs_[i], s)
+                        x[level * n + j] -= s
+                    continue
+                _load_Ft(fq, hv, Y, m, cols, n)
+                if HAS_MASS:
+                    mass(t, q, p, Mw)
+                    if ldl_inplace(Mw, n, MASS_RTOL) != 0:
+                        return _MASS_NOT_SPD
+                    ldl_solve_columns(Mw, n, Y, cols)
+                _gram_lower(fq, hv, Y, S, m, cols, n)
+                if ldl_inplace(S, cols, S_RTOL) != 0:
+                    return _SINGULAR_S
+                ldl_solve_inplace(S, cols, rhs_)
+                for j in range(n):
+                    s = -0.0
+                    for i in range(cols):
+                        s = fma(Y[j, i], rhs_[i], s)
+                    x[level * n + j] -= s
+        return _OK
+
+    @njit(error_model="numpy")
+    def energy(t, x, p, ws):
+        q, v = ws.q, ws.v
+        for i in range(n):
+            q[i] = x[i]
+            v[i] = x[n + i]
+        return energy_fn(t, q, v, p)
+
+    key = fingerprint(
+        "pieces", n, m, k, model.structure_key() if SPARSE else "dense",
+        tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
+        optional_fingerprint(model.energy),
+    )  # fmt: skip
+    tag(key, residual, energy, project, make_workspace, stack_workspace)
+    return SimpleNamespace(**locals())
+
+
+def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
+    # The sparse path (:mod:`.sparsity`) where the model's structure pays for it; not for
+    # the least-squares multiplier or the correction of Ascher et al., which stay dense.
+    sparse = not (lstsq or law_code == LAW_ACPR) and model.sparse_structure() is not None
+    P = memo(model, ("pieces", sparse), lambda: _pieces(model, sparse))
+    # compile-time constants of the right-hand side's closure
+    n, m, k, r, ng, fns = P.n, P.m, P.k, P.r, P.ng, P.fns
+    HAS_MASS, HAS_HT, SPARSE = P.HAS_MASS, P.HAS_HT, P.SPARSE
+    mass, forces, f_accel, h_t = P.mass, P.forces, P.f_accel, P.h_t
+    residual, project, energy = P.residual, P.project, P.energy
+    make_workspace, stack_workspace = P.make_workspace, P.stack_workspace
+    sparse_Y, sparse_S = P.sparse_Y, P.sparse_S
+    FPTR, FCOL, CPTR, CROW, HQPTR, HQCOL = P.FPTR, P.FCOL, P.CPTR, P.CROW, P.HQPTR, P.HQCOL
+    LPTR, LCOL, LTPTR, LROW = P.LPTR, P.LCOL, P.LTPTR, P.LROW
+    LAW = law_code
+    LSTSQ = lstsq
+    law_A = _rejit(law_fn, _noop4)
 
     @njit(forceinline=True, error_model="numpy")
     def rhs(t, x, p, law_mat, law_scal, ws, xdot):
@@ -426,84 +525,12 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         # not branches, which LLVM sank the S test into and then could not vectorize
         return max(_MASS_NOT_SPD * bad_mass, _SINGULAR_S * bad_S)
 
-    @njit(error_model="numpy")
-    def project(t, x, p, ws, sweeps, tol):
-        """Move ``x`` onto (towards) the manifold ``g = 0``, in place; return a status.
-
-        Positions first, then velocities at the corrected positions (the block form of
-        ``x ← x − D (G D)⁻¹ g`` of Ascher et al.), each level repeated until its residual
-        max-norm is ``≤ tol``, stops halving (the roundoff level) or ``sweeps``
-        corrections were made::
-
-            q ← q − M⁻¹f_qᵀ (f_q M⁻¹f_qᵀ)⁻¹ f          (Gauss–Newton in the M metric)
-            v ← v − M⁻¹Fᵀ S⁻¹ (ḟ, h)
-
-        One sweep with ``tol = 0`` is post-stabilization; sweeps to a small tolerance are
-        coordinate projection.
-        """
-        Mw, fq, hv, Y, S, g, sm, mu = ws.M, ws.fq, ws.hv, ws.Y, ws.S, ws.g, ws.sm, ws.mu
-        q = ws.q
-        for level in range(2):
-            if (level == 0 and m == 0) or (level == 1 and r == 0):
-                continue
-            lo, cols = (0, m) if level == 0 else (m, r)
-            prev = math.inf
-            for _ in range(sweeps):
-                residual(t, x, p, ws, g)
-                err = 0.0
-                for i in range(cols):
-                    err = max(err, abs(g[lo + i]))
-                if err <= tol or err > 0.5 * prev:  # converged, or at the roundoff level
-                    break
-                prev = err
-                rhs_ = sm if level == 0 else mu
-                for i in range(cols):
-                    rhs_[i] = g[lo + i]
-                if SPARSE:
-                    if sparse_Y(t, q, p, ws, cols):
-                        return _MASS_NOT_SPD
-                    if sparse_S(ws, cols):
-                        return _SINGULAR_S
-                    ldl_sparse_solve(S, cols, rhs_, LPTR, LCOL, LTPTR, LROW)
-                    for j in range(n):
-                        s = -0.0
-                        for e in range(CPTR[j], CPTR[j + 1]):
-                            i = CROW[e]
-                            if i < cols:
-                                s = fma(Y[j, i], rhs_[i], s)
-                        x[level * n + j] -= s
-                    continue
-                _load_Ft(fq, hv, Y, m, cols, n)
-                if HAS_MASS:
-                    mass(t, q, p, Mw)
-                    if ldl_inplace(Mw, n, MASS_RTOL) != 0:
-                        return _MASS_NOT_SPD
-                    ldl_solve_columns(Mw, n, Y, cols)
-                _gram_lower(fq, hv, Y, S, m, cols, n)
-                if ldl_inplace(S, cols, S_RTOL) != 0:
-                    return _SINGULAR_S
-                ldl_solve_inplace(S, cols, rhs_)
-                for j in range(n):
-                    s = -0.0
-                    for i in range(cols):
-                        s = fma(Y[j, i], rhs_[i], s)
-                    x[level * n + j] -= s
-        return _OK
-
-    @njit(error_model="numpy")
-    def energy(t, x, p, ws):
-        q, v = ws.q, ws.v
-        for i in range(n):
-            q[i] = x[i]
-            v[i] = x[n + i]
-        return energy_fn(t, q, v, p)
-
     key = fingerprint(
         "kernels", n, m, k, model.structure_key() if SPARSE else "dense",
         tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
         optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
         *(("lstsq",) if lstsq else ()),
     )  # fmt: skip
-    tag(key, rhs, residual, energy, project, make_workspace, stack_workspace)
+    tag(key, rhs)
     return Kernels(rhs, residual, energy, project, make_workspace, stack_workspace, n, m, k,
                    ng, key)
