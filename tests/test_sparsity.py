@@ -83,6 +83,23 @@ def test_fekete_uses_the_sparse_path_and_matches_a_direct_evaluation():
     np.testing.assert_array_equal(xdot[:n], x[n:])
 
 
+def test_law_kinds_share_the_pieces_no_law_touches():
+    """The sampler's kernels (the constant law) and a run's under Baumgarte's law (its three
+    factors on the sparse path) use the same residual, projection and workspace, compiled
+    once; each law kind has its own right-hand side; the least-squares multiplier, which
+    stays dense, has its own pieces."""
+    from stabdae.kernels.sampler import _Unstabilized
+
+    model = stabdae.load_model(KERNELS / "fekete.py")
+    run = kernels_for(model, bind_law(stabdae.baumgarte(10.0, 1.0), model))
+    sampler = kernels_for(model, _Unstabilized)
+    assert (run.residual, run.project, run.energy, run.make_workspace) == (
+        sampler.residual, sampler.project, sampler.energy, sampler.make_workspace)
+    assert run.rhs is not sampler.rhs and run.key != sampler.key
+    dense = kernels_for(model, bind_law(stabdae.baumgarte(10.0, 1.0), model), "lstsq")
+    assert dense.residual is not run.residual
+
+
 def test_fill_of_an_arrow_matrix_and_of_a_band():
     """The factor's pattern: an arrow pointing up-left fills completely, one pointing
     down-right not at all; a band keeps its width."""
