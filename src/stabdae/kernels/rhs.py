@@ -362,7 +362,7 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     sparse = not (lstsq or law_code == LAW_ACPR) and model.sparse_structure() is not None
     P = memo(model, ("pieces", sparse), lambda: _pieces(model, sparse))
     # compile-time constants of the right-hand side's closure
-    n, m, k, r, ng, fns = P.n, P.m, P.k, P.r, P.ng, P.fns
+    n, m, k, r, ng = P.n, P.m, P.k, P.r, P.ng
     HAS_MASS, HAS_HT, SPARSE = P.HAS_MASS, P.HAS_HT, P.SPARSE
     mass, forces, f_accel, h_t = P.mass, P.forces, P.f_accel, P.h_t
     residual, project, energy = P.residual, P.project, P.energy
@@ -525,12 +525,10 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
         # not branches, which LLVM sank the S test into and then could not vectorize
         return max(_MASS_NOT_SPD * bad_mass, _SINGULAR_S * bad_S)
 
-    key = fingerprint(
-        "kernels", n, m, k, model.structure_key() if SPARSE else "dense",
-        tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
-        optional_fingerprint(model.energy), law_code, optional_fingerprint(law_fn),
-        *(("lstsq",) if lstsq else ()),
-    )  # fmt: skip
+    # the model's part of the key is the pieces' (its functions, energy and structure);
+    # None (no cache) where that is
+    key = P.key and fingerprint("kernels", P.key, law_code, optional_fingerprint(law_fn),
+                                *(("lstsq",) if lstsq else ()))  # fmt: skip
     tag(key, rhs)
     return Kernels(rhs, residual, energy, project, make_workspace, stack_workspace, n, m, k,
                    ng, key)
