@@ -8,8 +8,8 @@ consistent reference state to ``t_end``:
 * stabdae, through the public API (``stabdae.integrate`` / ``integrate_adaptive``), every
   combination of
 
-  - method: fixed-step ``rk4`` and ``dopri5`` over a ladder of steps τ, and the adaptive
-    Dormand–Prince 5(4) pair over a ladder of tolerances;
+  - method: fixed-step ``rk4``, ``dopri5`` and ``dop853`` over a ladder of steps τ, and
+    the adaptive pairs Dormand–Prince 5(4) and DOP853 over a ladder of tolerances;
   - stabilization: ``none`` (the index-1 equations, A = 0), ``baumgarte`` (the paper's
     law), ``acpr`` (Ascher–Chin–Petzold–Reich), ``post`` (A = 0 with post-stabilization
     after each step), ``projection`` (A = 0 with coordinate projection after each step);
@@ -317,8 +317,9 @@ def run_scene(scene: Scene, *, quick: bool, ida: bool, log=print) -> tuple[list,
         warnings.simplefilter("ignore", stabdae.IntegrationWarning)
         for stab in scene.stabilizations:
             law, proj = law_for(model, scene, stab), projection_for(stab)
-            for scheme in ("rk4", "dopri5"):
-                stages = stabdae.rk4().stages if scheme == "rk4" else stabdae.dopri5().stages
+            for scheme, make in (("rk4", stabdae.rk4), ("dopri5", stabdae.dopri5),
+                                 ("dop853", stabdae.dop853)):  # fmt: skip
+                stages = make().stages
                 tau = (scene.t_end - t0) / steps[0]
                 stabdae.integrate(model, x0, law, scheme, tau, t0 + tau, tau,
                                   multiplier=scene.multiplier, projection=proj)  # compile
@@ -333,13 +334,15 @@ def run_scene(scene: Scene, *, quick: bool, ida: bool, log=print) -> tuple[list,
             stabdae.integrate_adaptive(model, x0, law, scene.t_end, rtol=1e-3, atol=1e-3,
                                        max_steps=10, multiplier=scene.multiplier,
                                        projection=proj)  # compile  # fmt: skip
-            for tol in tols:
-                ds, wall = timed(stabdae.integrate_adaptive, model, x0, law, scene.t_end,
-                                 rtol=tol, atol=tol, multiplier=scene.multiplier,
-                                 projection=proj)  # fmt: skip
-                st = stabdae.Status(ds.attrs["status"]).name.lower()
-                record("dopri5-adaptive", stab, "rtol", tol, ds["x"].values[-1], wall,
-                       ds.attrs["rhs_evaluations"], st, ds.residual_norm.values[-1])  # fmt: skip
+            for pair in ("dopri5", "dop853"):
+                for tol in tols:
+                    ds, wall = timed(stabdae.integrate_adaptive, model, x0, law, scene.t_end,
+                                     scheme=pair, rtol=tol, atol=tol,
+                                     multiplier=scene.multiplier, projection=proj)  # fmt: skip
+                    st = stabdae.Status(ds.attrs["status"]).name.lower()
+                    record(f"{pair}-adaptive", stab, "rtol", tol, ds["x"].values[-1], wall,
+                           ds.attrs["rhs_evaluations"], st,
+                           ds.residual_norm.values[-1])  # fmt: skip
 
     if scene.peers:
         sys1 = Index1(model, p)
@@ -453,7 +456,8 @@ def plot(ds: xr.Dataset, path: Path, cost: str):
     fig, axes = plt.subplots(rows_, cols, figsize=(5.2 * cols, 4.2 * rows_), squeeze=False)
     colors = dict(none="tab:gray", baumgarte="tab:blue", acpr="tab:green", post="tab:orange",
                   projection="tab:red")  # fmt: skip
-    marks = {"rk4": "o", "dopri5": "s", "dopri5-adaptive": "^", "scipy-DOP853": "P",
+    marks = {"rk4": "o", "dopri5": "s", "dop853": "v", "dopri5-adaptive": "^",
+             "dop853-adaptive": "<", "scipy-DOP853": "P",
              "scipy-Radau": "X", "sundials-IDA": "D"}  # fmt: skip
     for ax, scene in zip(axes.ravel(), scenes):
         sel = ds.where(ds.scene == scene, drop=True)

@@ -225,22 +225,24 @@ def test_ensemble_errors():
 
 
 # ---------------------------------------------------------------- adaptive steps per member
-def test_adaptive_members_control_their_own_steps():
+@pytest.mark.parametrize("pair", ["dopri5", "dop853"])
+def test_adaptive_members_control_their_own_steps(pair):
     """Pendulums swinging at different amplitudes need different numbers of steps; each
-    member is bit-for-bit the single adaptive integration from its start."""
+    member is bit-for-bit the single adaptive integration from its start, with either
+    embedded pair."""
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)
     angles = np.array([0.1, 0.8, 1.6, 2.6])
     x0 = np.stack([[np.sin(a), -np.cos(a), 0.0, 0.0] for a in angles])
     kw = dict(rtol=1e-8, atol=1e-10, save_dt=0.5, residual_dtype="float64")
-    ds = stabdae.ensemble(model, law, tau=1e-3, t_end=2.0, x0=x0, **kw)
-    assert ds.attrs["method"] == "dopri5-adaptive" and ds.attrs["first_step"] == 1e-3
+    ds = stabdae.ensemble(model, law, pair, tau=1e-3, t_end=2.0, x0=x0, **kw)
+    assert ds.attrs["method"] == f"{pair}-adaptive" and ds.attrs["first_step"] == 1e-3
     steps = ds.steps_accepted.values
     assert len(set(steps.tolist())) == len(angles), steps  # every member its own count
     for j in range(len(angles)):
-        one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, rtol=1e-8, atol=1e-10,
-                                         save_dt=0.5, first_step=1e-3)  # fmt: skip
-        assert one.attrs["steps_accepted"] == steps[j]
+        one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, scheme=pair, rtol=1e-8,
+                                         atol=1e-10, save_dt=0.5, first_step=1e-3)  # fmt: skip
+        assert one.attrs["method"] == pair and one.attrs["steps_accepted"] == steps[j]
         assert one.attrs["rhs_evaluations"] == ds.rhs_evaluations.values[j]
         np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
         np.testing.assert_array_equal(ds.residual_norm.values[j], one.residual_norm.values)
@@ -276,9 +278,8 @@ def test_adaptive_ensemble_isolates_divergence():
 def test_adaptive_ensemble_errors():
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0)
-    with pytest.raises(
-        ValueError, match="^ensemble: .*scheme must be 'dopri5' or left out, got 'rk4'"
-    ):
+    with pytest.raises(ValueError, match=r"^ensemble: adaptive steps need an embedded pair, "
+                       r"'dopri5' \(Dormand–Prince 5\(4\)\) or 'dop853' .*; got 'rk4'"):
         stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, rtol=1e-6)
     with pytest.raises(ValueError, match="^ensemble: atol is for adaptive steps; give rtol"):
         stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, atol=1e-6)
@@ -292,11 +293,12 @@ def _scheme(spec):
         return stabdae.two_stage(*spec)
 
 
-@pytest.mark.parametrize("spec", ["euler", "midpoint", "rk4", "dopri5", (0.3, 0.0), (0.25, 2.0)])
+@pytest.mark.parametrize("spec", ["euler", "midpoint", "rk4", "dop853", (0.3, 0.0), (0.25, 2.0)])
 def test_every_tableau_pattern_equals_single_integrations(spec):
     """The ensemble kernel is compiled per pattern of zero / one / other coefficients and
     writes the stages out; its numbers are still those of ``integrate`` bit for bit
-    (σ = 0 has a zero weight, σ = 2 two general ones, dopri5 zeros inside A)."""
+    (σ = 0 has a zero weight, σ = 2 two general ones, DOP853 twelve stages and zeros
+    inside A and b; dopri5's pattern is covered below)."""
     scheme = _scheme(spec)
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)

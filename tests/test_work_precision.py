@@ -31,7 +31,7 @@ def test_work_precision_study_runs(tmp_path):
         assert ds[name].attrs["long_name"], name
     methods = set(zip(ds.method.values.tolist(), ds.stabilization.values.tolist()))
     for stab in wp.STABILIZATIONS:
-        for method in ("rk4", "dopri5", "dopri5-adaptive"):
+        for method in ("rk4", "dopri5", "dop853", "dopri5-adaptive", "dop853-adaptive"):
             assert (method, stab) in methods
     for peer in ("scipy-DOP853", "scipy-Radau"):
         assert (peer, "none") in methods and (peer, "projection") in methods

@@ -18,6 +18,7 @@ from ._model import Model, ModelError
 from ._schemes import (
     Scheme,
     SchemeError,
+    dop853,
     dopri5,
     euler,
     heun,
@@ -43,6 +44,7 @@ __all__ = [
     "acpr",
     "baumgarte",
     "boundary",
+    "dop853",
     "dopri5",
     "ensemble",
     "euler",

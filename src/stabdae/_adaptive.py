@@ -1,4 +1,4 @@
-"""Adaptive steps with the embedded Dormand–Prince 5(4) pair for one trajectory.
+"""Adaptive steps with an embedded pair (Dormand–Prince 5(4), DOP853) for one trajectory.
 
 For reference solutions and work–precision comparisons: the stabilized right-hand side
 (3.1), (3.11) integrated with local error control (the loop: :mod:`.kernels.adaptive`).
@@ -14,7 +14,6 @@ from . import _validate as check
 from ._integrate import IntegrationWarning, _multipliers
 from ._model import Model
 from ._schema import trajectory_dataset
-from ._schemes import dopri5, dopri5_embedded_weights
 from ._status import Status
 from .kernels.adaptive import adaptive_for
 
@@ -27,6 +26,7 @@ def integrate_adaptive(
     law=None,
     t_end: float = 1.0,
     *,
+    scheme="dopri5",
     rtol: float = 1e-8,
     atol: float = 1e-10,
     save_dt: float | None = None,
@@ -38,7 +38,7 @@ def integrate_adaptive(
     projection: str | None = None,
     with_multipliers: bool = False,
 ):
-    """Integrate one trajectory of the stabilized equations with Dormand–Prince 5(4).
+    """Integrate one trajectory of the stabilized equations with adaptive steps.
 
     Parameters
     ----------
@@ -50,6 +50,11 @@ def integrate_adaptive(
         index-1 equations).
     t_end : float
         Final time.
+    scheme : {"dopri5", "dop853"} or Scheme
+        The embedded pair: Dormand–Prince 5(4) (7 stages, the last one reused), or
+        Hairer's DOP853 (order 8 with fifth- and third-order error estimates, 12 stages and
+        one more evaluation at the new state, reused as the next step's first), cheaper
+        per digit at tight tolerances.
     rtol, atol : float
         Relative and absolute local error tolerances (per state component, RMS norm).
     save_dt : float, optional
@@ -74,7 +79,7 @@ def integrate_adaptive(
     Returns
     -------
     xarray.Dataset
-        As :func:`stabdae.integrate`, with attributes ``method = "dopri5"``, ``rtol``,
+        As :func:`stabdae.integrate`, with attributes ``method`` (the pair's name), ``rtol``,
         ``atol``, ``steps_accepted``, ``steps_rejected`` and ``rhs_evaluations``.
 
     Examples
@@ -104,8 +109,9 @@ def integrate_adaptive(
     bound = check.bound_law(law, model, who)
     multiplier = check.multiplier(multiplier, bound, who)
     sweeps, tol = check.projection(projection, who)
+    pair = check.pair(scheme, who)
+    scheme = pair.scheme
 
-    scheme = dopri5()
     kernel = adaptive_for(model, bound, multiplier)
     nsave = save_times.shape[0] + 1
     out_x = np.full((nsave, 2 * model.n), np.nan)
@@ -113,9 +119,9 @@ def integrate_adaptive(
     out_e = np.full(nsave, np.nan)
     counts = np.zeros(3, dtype=np.int64)
     status, written = kernel(
-        x0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
-        dopri5_embedded_weights(), scheme.c, rtol, atol, h0, int(max_steps), sweeps, tol,
-        out_x, out_g, out_e, counts,
+        x0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b, pair.error,
+        scheme.c, pair.combined, pair.error_order, rtol, atol, h0, int(max_steps), sweeps,
+        tol, out_x, out_g, out_e, counts,
     )  # fmt: skip
     status = Status(status)
     if status != Status.OK:
@@ -129,7 +135,7 @@ def integrate_adaptive(
     times = np.concatenate([[t0], save_times])
     ds = trajectory_dataset(
         model, p, law, scheme, times, out_x, out_g, out_e, status, int(counts[0]),
-        dict(method="dopri5", rtol=rtol, atol=atol, t0=t0, t_end=float(t_end),
+        dict(method=pair.name, rtol=rtol, atol=atol, t0=t0, t_end=float(t_end),
              steps=int(counts[0]), multiplier=multiplier,
              projection=str(projection).lower()),
         action="integrate_adaptive",

@@ -25,7 +25,6 @@ from ._integrate import IntegrationWarning
 from ._laws import Theorem5
 from ._model import Model
 from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_variable, variable
-from ._schemes import dopri5, dopri5_embedded_weights
 from ._status import Status
 from .kernels import decay
 from .kernels.adaptive import adaptive_ensemble_for
@@ -167,17 +166,18 @@ def ensemble(
     ----------
     model : Model
     law : Law or @njit function
-    scheme : Scheme or str, default "rk2" (the midpoint rule; "dopri5" with ``rtol``)
+    scheme : Scheme or str, default "rk2" (the midpoint rule; with ``rtol``: "dopri5", or
+        "dop853")
     tau, t_end, save_dt : float
         Fixed step, final time, spacing of stored residual norms (as in :func:`integrate`;
         default ``save_dt``: about 200 samples).  With ``rtol``, ``tau`` is every member's
         first step and ``save_dt`` need not be a multiple of it.
     rtol, atol : float, optional
-        Adaptive steps: each member controls its own step with the embedded Dormand–Prince
-        5(4) pair (as :func:`integrate_adaptive`) to these tolerances (``atol`` defaults
-        to ``rtol``).  The dataset then also has ``steps_accepted`` and
-        ``rhs_evaluations`` per member, and only the continuous-time prediction
-        ``beta_theory``.
+        Adaptive steps: each member controls its own step with the scheme's embedded pair
+        (Dormand–Prince 5(4) by default, or DOP853; as :func:`integrate_adaptive`) to
+        these tolerances (``atol`` defaults to ``rtol``).  The dataset then also has
+        ``steps_accepted`` and ``rhs_evaluations`` per member, and only the
+        continuous-time prediction ``beta_theory``.
     members : int
         Ensemble size (ignored when ``x0`` is given).
     radius : float or (low, high)
@@ -239,14 +239,10 @@ def ensemble(
     model = check.model(model, who)
     law = check.law(law, who)
     adaptive = rtol is not None
+    pair = None
     if adaptive:
-        given = None if scheme is None else check.scheme(scheme, who).name
-        if given not in (None, "dopri5"):
-            raise ValueError(
-                f"{who}: adaptive steps (rtol given) use the Dormand–Prince 5(4) pair; scheme "
-                f"must be 'dopri5' or left out, got {given!r}"
-            )
-        scheme = dopri5()
+        pair = check.pair(None if scheme is None else check.scheme(scheme, who), who)
+        scheme = pair.scheme
         rtol = check.positive(rtol, "rtol", who)
         atol = rtol if atol is None else check.positive(atol, "atol", who)
     elif atol is not None:
@@ -303,10 +299,10 @@ def ensemble(
     M = x0.shape[0]
     clock = time.perf_counter()
     if adaptive:
-        out = _run_adaptive(model, bound, x0, alpha0, status, p, t0, save_times, rtol, atol,
-                            tau, divergence, R, h_pred, trace_row, traced, rdtype, threads,
-                            progress)  # fmt: skip
-        run = dict(method="dopri5-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
+        out = _run_adaptive(model, bound, pair, x0, alpha0, status, p, t0, save_times, rtol,
+                            atol, tau, divergence, R, h_pred, trace_row, traced, rdtype,
+                            threads, progress)  # fmt: skip
+        run = dict(method=f"{pair.name}-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
                    t_end=float(t_end), save_dt=save_dt)  # fmt: skip
     else:
         out = _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every,
@@ -457,7 +453,7 @@ def measure_stride(R) -> int:
     return int(min(MAX_STRIDE, max(1, math.floor(STRIDE_CHANGE / change))))
 
 
-def _run_adaptive(model, bound, x0, alpha0, status, p, t0, save_times, rtol, atol,
+def _run_adaptive(model, bound, pair, x0, alpha0, status, p, t0, save_times, rtol, atol,
                   first_step, divergence, R, h_pred, trace_row, traced, rdtype, threads,
                   progress) -> dict:  # fmt: skip
     """The per-member adaptive kernel over chunks of members on threads."""
@@ -471,12 +467,13 @@ def _run_adaptive(model, bound, x0, alpha0, status, p, t0, save_times, rtol, ato
     steps = np.zeros(M, dtype=np.int64)
     nfev = np.zeros(M, dtype=np.int64)
     kernel = adaptive_ensemble_for(model, bound)
-    scheme = dopri5()
+    sc = pair.scheme
     alpha0 = np.ascontiguousarray(alpha0)
 
     def chunk(lo, hi):
-        kernel(x0, alpha0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b,
-               dopri5_embedded_weights(), scheme.c, rtol, atol, first_step, 10_000_000,
+        kernel(x0, alpha0, t0, save_times, p, bound.matrix, bound.scalars, sc.A, sc.b,
+               pair.error, sc.c, pair.combined, pair.error_order, rtol, atol, first_step,
+               10_000_000,
                divergence, R, h_pred, trace_row, out["norms"], out["meas"], out["x_final"],
                out["status"], out["fail_step"], out["e0"], out["e1"], steps, nfev, lo,
                hi)  # fmt: skip

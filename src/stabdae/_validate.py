@@ -18,7 +18,7 @@ import numpy as np
 
 from ._laws import Law, LawError, as_law, bind_law
 from ._model import Model, ModelError
-from ._schemes import Scheme, SchemeError, as_scheme
+from ._schemes import EmbeddedPair, Scheme, SchemeError, as_scheme, embedded_pair
 from .kernels.rhs import LAW_ACPR, MULTIPLIERS, PROJECTIONS
 
 __all__ = [
@@ -67,6 +67,14 @@ def bound_law(value: Law, model_: Model, who: str):
 def scheme(value, who: str, default: str | None = None) -> Scheme:
     try:
         return as_scheme(default if value is None else value)
+    except SchemeError as exc:
+        raise _prefixed(exc, who) from None
+
+
+def pair(value, who: str) -> EmbeddedPair:
+    """The embedded pair for adaptive steps: ``"dopri5"`` (the default) or ``"dop853"``."""
+    try:
+        return embedded_pair("dopri5" if value is None else value, who)
     except SchemeError as exc:
         raise _prefixed(exc, who) from None
 

@@ -1,12 +1,16 @@
-"""Adaptive steps with an embedded Runge–Kutta pair (Dormand–Prince 5(4)): the loop of one
-trajectory (:func:`adaptive_for`, behind :func:`stabdae.integrate_adaptive`) and the
-per-member ensemble kernel (:func:`adaptive_ensemble_for`, behind
-``stabdae.ensemble(rtol=...)``), both running the one loop of :func:`_adaptive_loop`.
+"""Adaptive steps with an embedded Runge–Kutta pair (Dormand–Prince 5(4) or Hairer's
+DOP853, :class:`stabdae._schemes.EmbeddedPair`): the loop of one trajectory
+(:func:`adaptive_for`, behind :func:`stabdae.integrate_adaptive`) and the per-member
+ensemble kernel (:func:`adaptive_ensemble_for`, behind ``stabdae.ensemble(rtol=...)``),
+both running the one loop of :func:`_adaptive_loop`.
 
-Local error control ``err = ‖e / (atol + rtol·max(|x|, |x̃|))‖_RMS ≤ 1`` per step,
-``e = τ Σ (b_i − b̂_i) k_i``, the step updated by ``0.9 err^{−1/5}`` within ``[0.2, 10]``
-(no growth right after a rejection), the first step chosen as in Hairer, Nørsett & Wanner
-(II.4).  Steps end exactly on the sample times.
+Local error control ``err ≤ 1`` per step with the error estimates ``e = τ Σ (b_i − b̂_i) k_i``
+scaled by ``atol + rtol·max(|x|, |x̃|)``: ``err`` is their RMS norm for Dormand–Prince, and
+``‖e₅‖² / √(‖e₅‖² + 0.01 ‖e₃‖²)`` of the fifth- and third-order estimates for DOP853 (as in
+Hairer's code and SciPy's).  The step is updated by ``0.9 err^{−1/(q+1)}`` within
+``[0.2, 10]`` (``q`` = 4 and 7: the estimate's order; no growth right after a rejection),
+the first step chosen as in Hairer, Nørsett & Wanner (II.4).  Steps end exactly on the
+sample times.  The pair's coefficients are run-time arrays: one compiled loop serves both.
 """
 
 from __future__ import annotations
@@ -42,13 +46,15 @@ def adaptive_ensemble_for(model, bound):
 
 
 def _adaptive_loop(K, save, label: str, accepted_step=None):
-    """The Dormand–Prince loop of one trajectory, with ``save(j, t, x, p, ws, g, out)``
+    """The adaptive loop of one trajectory, with ``save(j, t, x, p, ws, g, out)``
     storing sample ``j`` (it returns True to stop the trajectory: status DIVERGED) and
     ``accepted_step(t, ws, out)`` called after every accepted step, with ``ws.g`` the
-    residual at the new state (the last stage is evaluated there: first same as last).
+    residual at the new state (the last evaluation is there: first same as last).
 
-    ``run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c, rtol, atol,
-    h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g, out, counts)`` integrates ``x`` in
+    ``run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_e, tab_c, combined, q,
+    rtol, atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, g, out, counts)`` integrates
+    ``x`` with the pair's tableau, error weights ``tab_e`` (2 × s_e), norm (``combined``)
+    and estimate order ``q`` (:class:`stabdae._schemes.EmbeddedPair`; ``k`` has s_e rows) in
     place from ``t0`` through every time in ``save_times`` (increasing, after ``t0``);
     sample ``j + 1`` is saved at ``save_times[j]`` (sample 0 at ``t0``).  ``sweeps > 0``
     projects the state after each accepted step (``K.project``; the first stage of the
@@ -69,18 +75,11 @@ def _adaptive_loop(K, save, label: str, accepted_step=None):
         return rhs(t, x, p, law_mat, law_scal, ws, xdot)
 
     @njit(error_model="numpy")
-    def rms_error(x, xnew, err, rtol, atol):
-        s = 0.0
-        for l in range(N2):
-            sc = atol + rtol * max(abs(x[l]), abs(xnew[l]))
-            e = err[l] / sc
-            s += e * e
-        return math.sqrt(s / N2)
-
-    @njit(error_model="numpy")
-    def run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c, rtol,
-            atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g, out, counts):  # fmt: skip
+    def run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_e, tab_c, combined, q,
+            rtol, atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, g, out, counts):  # fmt: skip
         s = tab_b.shape[0]
+        s_e = tab_e.shape[1]  # s, or s + 1 with ẋ at the new state evaluated for the estimate
+        expo = 1.0 / (q + 1)
         t = t0
         nfev = 0
         counts[0], counts[1], counts[2] = 0, 0, 0
@@ -115,7 +114,7 @@ def _adaptive_loop(K, save, label: str, accepted_step=None):
                 if max(d1, d2) <= 1e-15:
                     h1 = max(1e-6, h * 1e-3)
                 else:
-                    h1 = (0.01 / max(d1, d2)) ** 0.2
+                    h1 = (0.01 / max(d1, d2)) ** expo
                 h = min(100.0 * h, h1)
         accepted = rejected = 0
         j = 0
@@ -150,26 +149,52 @@ def _adaptive_loop(K, save, label: str, accepted_step=None):
             if finite:
                 for l in range(N2):
                     acc = 0.0
-                    acc_e = 0.0
                     for i in range(s):
                         acc += tab_b[i] * k[i, l]
-                        acc_e += (tab_b[i] - tab_bh[i]) * k[i, l]
                     xnew[l] = x[l] + hh * acc
-                    err[l] = hh * acc_e
-                    if not (math.isfinite(xnew[l]) and math.isfinite(err[l])):
+                    if not math.isfinite(xnew[l]):
                         finite = False
+            if finite and s_e > s:  # ẋ at the new state, for the estimate and the next step
+                st = f_eval(t + hh, xnew, p, law_mat, law_scal, ws, k[s])
+                nfev += 1
+                finite = st == 0
+            e = 0.0
+            if finite:
+                # ‖·‖ over (atol + rtol max(|x|, |x_new|)): the RMS of τ Σ e_i k_i, or for
+                # DOP853 Hairer's ‖e₅‖² / √(‖e₅‖² + 0.01 ‖e₃‖²) from the two estimates
+                s5 = s3 = 0.0
+                for l in range(N2):
+                    sc = atol + rtol * max(abs(x[l]), abs(xnew[l]))
+                    acc5 = 0.0
+                    for i in range(s_e):
+                        acc5 += tab_e[0, i] * k[i, l]
+                    if combined:
+                        acc3 = 0.0
+                        for i in range(s_e):
+                            acc3 += tab_e[1, i] * k[i, l]
+                        e5, e3 = acc5 / sc, acc3 / sc
+                        s5 += e5 * e5
+                        s3 += e3 * e3
+                    else:
+                        e5 = hh * acc5 / sc
+                        s5 += e5 * e5
+                if combined:
+                    if s5 != 0.0 or s3 != 0.0:
+                        e = abs(hh) * s5 / math.sqrt((s5 + 0.01 * s3) * N2)
+                else:
+                    e = math.sqrt(s5 / N2)
+                finite = math.isfinite(e)
             if not finite:  # a failed evaluation or overflow: shrink hard and retry
                 rejected += 1
                 h = 0.25 * hh
                 after_reject = True
                 continue
-            e = rms_error(x, xnew, err, rtol, atol)
             if e <= 1.0:
                 accepted += 1
                 t = target if hit else t + hh
                 for l in range(N2):
                     x[l] = xnew[l]
-                    k[0, l] = k[s - 1, l]  # FSAL: the last stage is ẋ at the new point
+                    k[0, l] = k[s_e - 1, l]  # first same as last: ẋ at the new point
                 if sweeps > 0:
                     st = project(t, x, p, ws, sweeps, tol)
                     if st == 0:
@@ -179,7 +204,7 @@ def _adaptive_loop(K, save, label: str, accepted_step=None):
                         counts[0], counts[1], counts[2] = accepted, rejected, nfev
                         return st, j + 1
                 accepted_step(t, ws, out)
-                fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e ** -0.2))
+                fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e ** -expo))
                 if after_reject:
                     fac = min(fac, 1.0)
                 after_reject = False
@@ -191,12 +216,12 @@ def _adaptive_loop(K, save, label: str, accepted_step=None):
                         return _DIVERGED, j + 1
             else:
                 rejected += 1
-                h = hh * max(0.2, 0.9 * e ** -0.2)
+                h = hh * max(0.2, 0.9 * e ** -expo)
                 after_reject = True
         counts[0], counts[1], counts[2] = accepted, rejected, nfev
         return 0, nsave + 1
 
-    tag(kernel_key(K.key, f"adaptive-loop-{label}"), f_eval, rms_error, run)
+    tag(kernel_key(K.key, f"adaptive-loop-{label}"), f_eval, run)
     return run
 
 
@@ -218,17 +243,17 @@ def _build_adaptive(K):
     run = _adaptive_loop(K, save, "trajectory")
 
     @njit(error_model="numpy")
-    def adaptive_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
-                        tab_c, rtol, atol, h0, max_steps, sweeps, tol, out_x, out_g, out_e,
-                        counts):  # fmt: skip
+    def adaptive_kernel(x0, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_e,
+                        tab_c, combined, q, rtol, atol, h0, max_steps, sweeps, tol, out_x,
+                        out_g, out_e, counts):  # fmt: skip
         """One trajectory from ``x0``: the loop of :func:`_adaptive_loop` writing state,
         residual and energy samples into ``out_x``, ``out_g``, ``out_e``."""
         ws = make_workspace()
-        k = np.empty((tab_b.shape[0], N2))
-        xs, xnew, err, g = np.empty(N2), np.empty(N2), np.empty(N2), np.empty(ng)
+        k = np.empty((tab_e.shape[1], N2))
+        xs, xnew, g = np.empty(N2), np.empty(N2), np.empty(ng)
         x = x0.copy()
-        return run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh, tab_c,
-                   rtol, atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, err, g,
+        return run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_e, tab_c,
+                   combined, q, rtol, atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, g,
                    (out_x, out_g, out_e), counts)  # fmt: skip
 
     keyed_cache(adaptive_kernel, kernel_key(K.key, "adaptive-dopri5"))
@@ -265,16 +290,16 @@ def _build_adaptive_ensemble(K):
 
     @njit(nogil=True, error_model="numpy")
     def ensemble_kernel(x0, alpha0s, t0, save_times, p, law_mat, law_scal, tab_a, tab_b,
-                        tab_bh, tab_c, rtol, atol, h0, max_steps, divergence, R, h_pred,
-                        trace_row, norms, meas, x_final, status, fail_step, e0, e1, steps,
-                        nfev, lo, hi):  # fmt: skip
+                        tab_e, tab_c, combined, q, rtol, atol, h0, max_steps, divergence, R,
+                        h_pred, trace_row, norms, meas, x_final, status, fail_step, e0, e1,
+                        steps, nfev, lo, hi):  # fmt: skip
         """Members ``lo … hi − 1``, each with its own step control; the buffers are
         allocated once per call (a chunk of members), not per member.  Stored samples
         and decay measures as in the fixed-step kernel (:mod:`.ensemble`); the linear
         prediction steps ``g`` by ``R = e^{Ã h_pred}``."""
         ws = make_workspace()
-        k = np.empty((tab_b.shape[0], N2))
-        xs, xnew, err, g = np.empty(N2), np.empty(N2), np.empty(N2), np.empty(ng)
+        k = np.empty((tab_e.shape[1], N2))
+        xs, xnew, g = np.empty(N2), np.empty(N2), np.empty(ng)
         x = np.empty(N2)
         counts = np.zeros(3, dtype=np.int64)
         tend = save_times[save_times.shape[0] - 1]
@@ -301,9 +326,9 @@ def _build_adaptive_ensemble(K):
             for l in range(ng):
                 r0 = max(r0, abs(g[l]))
             begin(lt, lv, base, meas, 0, i, r0, r0)
-            st, written = run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_bh,
-                              tab_c, rtol, atol, h0, max_steps, 0, 0.0, ws, k, xs, xnew,
-                              err, g, (norms, i, divergence, trace_row, lt, lv, base, meas,
+            st, written = run(x, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_e,
+                              tab_c, combined, q, rtol, atol, h0, max_steps, 0, 0.0, ws, k,
+                              xs, xnew, g, (norms, i, divergence, trace_row, lt, lv, base, meas,
                                        t0, span), counts)  # fmt: skip
             for l in range(N2):
                 x_final[i, l] = x[l]

@@ -237,7 +237,8 @@ def main(argv: list[str] | None = None) -> int:
     itg.add_argument("--xi", type=float, default=1.0, help="Baumgarte's damping ratio xi")
     itg.add_argument("--k", type=float, default=10.0, help="gain of ḣ = −k h")
     itg.add_argument("--scheme", default="rk2",
-                     help="euler | rk2 | midpoint | heun | rk3 | heun3 | rk4 | dopri5 | two_stage")
+                     help="euler | rk2 | midpoint | heun | rk3 | heun3 | rk4 | dopri5 | dop853 | "
+                          "two_stage")
     itg.add_argument("--tableau", metavar="JSON",
                      help='your own explicit tableau, e.g. \'{"A": [[0, 0], [1, 0]], "b": [0.5, '
                           '0.5], "c": [0, 1], "order": 2}\' (instead of --scheme)')
