@@ -27,7 +27,7 @@ from ._model import Model
 from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_variable, variable
 from ._status import Status
 from .kernels import decay
-from .kernels.adaptive import adaptive_ensemble_for
+from .kernels.adaptive import LANES, adaptive_block_for
 from .kernels.ensemble import BLOCK, ensemble_kernel_for
 from .kernels.sampler import (
     CHUNK,
@@ -153,7 +153,7 @@ def ensemble(
     params=None,
     epsilon: float | None = None,
     divergence: float | None = None,
-    block: int = BLOCK,
+    block: int | None = None,
     threads: int | None = None,
     progress=None,
     residual_dtype="float32",
@@ -259,7 +259,9 @@ def ensemble(
     else:
         nsteps, save_every = check.fixed_time_grid(span, tau, save_dt, who,
                                                    default_samples=DEFAULT_SAMPLES)  # fmt: skip
-    block = check.block(block, model.n, who)
+    if block is None:
+        block = LANES if adaptive else BLOCK
+    block = check.block(block, model.n, who, copies=4 if adaptive else 2)
     rdtype = check.dtype(residual_dtype, "residual_dtype", ("float32", "float64"), who)
     low, high = check.radius(radius, who)
     seed = check.seed(seed, who)
@@ -299,8 +301,8 @@ def ensemble(
     M = x0.shape[0]
     clock = time.perf_counter()
     if adaptive:
-        out = _run_adaptive(model, bound, pair, x0, alpha0, status, p, t0, save_times, rtol,
-                            atol, tau, divergence, R, h_pred, trace_row, traced, rdtype,
+        out = _run_adaptive(model, bound, pair, block, x0, alpha0, status, p, t0, save_times,
+                            rtol, atol, tau, divergence, R, h_pred, trace_row, traced, rdtype,
                             threads, progress)  # fmt: skip
         run = dict(method=f"{pair.name}-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
                    t_end=float(t_end), save_dt=save_dt)  # fmt: skip
@@ -453,8 +455,8 @@ def measure_stride(R) -> int:
     return int(min(MAX_STRIDE, max(1, math.floor(STRIDE_CHANGE / change))))
 
 
-def _run_adaptive(model, bound, pair, x0, alpha0, status, p, t0, save_times, rtol, atol,
-                  first_step, divergence, R, h_pred, trace_row, traced, rdtype, threads,
+def _run_adaptive(model, bound, pair, lanes, x0, alpha0, status, p, t0, save_times, rtol,
+                  atol, first_step, divergence, R, h_pred, trace_row, traced, rdtype, threads,
                   progress) -> dict:  # fmt: skip
     """The per-member adaptive kernel over chunks of members on threads."""
     M = x0.shape[0]
@@ -466,14 +468,13 @@ def _run_adaptive(model, bound, pair, x0, alpha0, status, p, t0, save_times, rto
     out["status"][:] = status  # members that could not be placed stay out
     steps = np.zeros(M, dtype=np.int64)
     nfev = np.zeros(M, dtype=np.int64)
-    kernel = adaptive_ensemble_for(model, bound)
+    kernel = adaptive_block_for(model, bound, pair, lanes)
     sc = pair.scheme
     alpha0 = np.ascontiguousarray(alpha0)
 
     def chunk(lo, hi):
         kernel(x0, alpha0, t0, save_times, p, bound.matrix, bound.scalars, sc.A, sc.b,
-               pair.error, sc.c, pair.combined, pair.error_order, rtol, atol, first_step,
-               10_000_000,
+               pair.error, sc.c, pair.error_order, rtol, atol, first_step, 10_000_000,
                divergence, R, h_pred, trace_row, out["norms"], out["meas"], out["x_final"],
                out["status"], out["fail_step"], out["e0"], out["e1"], steps, nfev, lo,
                hi)  # fmt: skip

@@ -119,17 +119,18 @@ def count(value, name: str, who: str) -> int:
 BLOCK_STACK_BYTES = 2**20
 
 
-def block(value, n: int, who: str, name: str = "block") -> int:
+def block(value, n: int, who: str, name: str = "block", copies: int = 2) -> int:
     """Members per lockstep block: a positive integer whose states fit the thread's stack
-    (two copies of 2n doubles per member)."""
+    (``copies`` copies of 2n doubles per member: two for fixed steps, four for the
+    adaptive lanes)."""
     value = count(value, name, who)
-    per_member = 2 * 2 * n * 8 + 8
+    per_member = copies * 2 * n * 8 + 8
     most = BLOCK_STACK_BYTES // per_member
     if value > most:
         raise ValueError(
             f"{who}: {name} = {value} needs {value * per_member / 2**20:.1f} MiB of thread "
-            f"stack for the block's states (two copies of 2n = {2 * n} doubles per member); "
-            f"at most {most} for this model (64, the default, is as fast)"
+            f"stack for the block's states ({copies} copies of 2n = {2 * n} doubles per "
+            f"member); at most {most} for this model (the default is as fast)"
         )
     return value
 
