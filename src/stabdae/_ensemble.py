@@ -195,9 +195,11 @@ def ensemble(
     divergence : float, optional
         Residual norm above which a member is frozen and flagged ``diverged``
         (default ``1e3 × epsilon``, and at least 1: a residual of the model's own size).
-    block : int
-        Members integrated in lockstep per parallel work item (compile-time: a new value
-        compiles a new kernel).  Does not change any number.
+    block : int, optional
+        Members integrated in lockstep per parallel work item (default 64), or with
+        ``rtol`` the lanes that run members side by side, each with its own steps
+        (default 8).  Compile-time: a new value compiles a new kernel.  Does not change
+        any number.
     threads : int, optional
         Threads to run the blocks on (default numba's thread count, ``NUMBA_NUM_THREADS``).
         Does not change any number.
