@@ -251,13 +251,14 @@ def test_adaptive_members_control_their_own_steps(pair):
 @pytest.mark.parametrize("pair", ["dopri5", "dop853"])
 def test_adaptive_lanes_refill_and_stay_bit_identical(pair):
     """Members of very different step counts (at rest to spinning at 100 rad/s) on three
-    lanes: a lane whose member has ended takes the next waiting one, and every
-    member is still the single adaptive integration bit for bit; a member that cannot
-    start (singular S) stops alone; nothing depends on the lanes or the threads."""
+    lanes, five or so members per work item (so lanes are refilled): a lane whose member
+    has ended takes the next waiting one, and every member is still the single adaptive
+    integration bit for bit; a member that cannot start (singular S) stops alone; nothing
+    depends on the lanes or the threads."""
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)
-    angles = [0.05, 3.0, 0.3, 2.9, 1.0, 0.1, 2.5, 0.8, 1.6, 0.2, 2.95]
-    spins = [0.0, 100.0, 0.5, 50.0, 2.0, 0.0, 80.0, 1.0, 20.0, 0.2, 40.0]
+    angles = np.linspace(0.05, 3.0, 35)
+    spins = np.random.default_rng(3).permutation(np.r_[0.0, np.geomspace(0.1, 100.0, 34)])
     x0 = np.stack([[np.sin(a), -np.cos(a), w * np.cos(a), w * np.sin(a)]
                    for a, w in zip(angles, spins)])  # fmt: skip
     x0 = np.insert(x0, 4, [0.0, 0.0, 0.1, 0.0], axis=0)  # the rod of length 0: S = 0
