@@ -59,10 +59,10 @@ def main(argv=None):
     ap.add_argument("--t-end", type=float, default=10.0)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--baseline", metavar="REV")
-    ap.add_argument("--child", nargs=5, help=argparse.SUPPRESS)
+    ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:  # one measurement for the baseline process
-        name, pair, rtol, npy, _ = args.child
+        name, pair, rtol, npy = args.child
         print(json.dumps(measure(name, pair, float(rtol), args.members, args.t_end,
                                  args.repeat, npy)))  # fmt: skip
         return
@@ -86,7 +86,7 @@ def main(argv=None):
                         base_npy = str(tmp / "base.npy")
                         out = subprocess.run(
                             [sys.executable, __file__, "--child", name, pair, str(rtol),
-                             base_npy, "-", "--members", str(args.members), "--t-end",
+                             base_npy, "--members", str(args.members), "--t-end",
                              str(args.t_end), "--repeat", str(args.repeat)],
                             check=True, capture_output=True, text=True, env=env,
                             cwd=str(tmp))  # fmt: skip

@@ -76,7 +76,7 @@ class Scheme:
             raise SchemeError(f"scheme {self.name!r}: weights must sum to 1, got {b.sum()}")
         if not np.allclose(A.sum(axis=1), c, atol=1e-14):
             raise SchemeError(f"scheme {self.name!r}: rows of A must sum to c")
-        got = tableau_order(A, b, c)
+        got = tableau_order(A, b)
         if got != self.order:
             raise SchemeError(
                 f"scheme {self.name!r}: declared order {self.order} but the order conditions "
@@ -150,13 +150,12 @@ def _density(tree) -> int:
     return _order_of(tree) * math.prod(_density(sub) for sub in tree)
 
 
-def tableau_order(A, b, c=None, max_order: int = 9, tol: float = 1e-12) -> int:
+def tableau_order(A, b, max_order: int = 9, tol: float = 1e-12) -> int:
     """The highest order ≤ ``max_order`` (at most 9) whose Butcher order conditions
     ``bᵀ Φ(t) = 1 / γ(t)`` hold to ``tol`` for every rooted tree ``t`` of that order and
     below; ``Φ(t)`` is the product over the root's subtrees of ``A Φ(subtree)`` (one per
     stage), ``Φ`` of the single node is 1 (Hairer, Nørsett & Wanner I, Theorem II.2.13).
-    ``c`` is not used: the conditions are written with ``A 1`` for the nodes, which the
-    tableau's own check ties to ``c``."""
+    The nodes enter as ``A 1``, which :class:`Scheme` ties to its ``c``."""
     A = np.asarray(A, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     if not 1 <= max_order <= 9:
@@ -273,15 +272,10 @@ def dopri5() -> Scheme:
     """Dormand–Prince 5(4), order 5 (the first-same-as-last 7-stage tableau).
 
     As a fixed-step scheme it is an ordinary fifth-order method; with
-    :func:`stabdae.integrate_adaptive` its embedded fourth-order weights
-    (:func:`dopri5_embedded_weights`) estimate the local error for step-size control.
+    :func:`stabdae.integrate_adaptive` its embedded fourth-order weights estimate the local
+    error for step-size control (:func:`embedded_pair`).
     """
     return Scheme("dopri5", _DP_A, _DP_B, _DP_C, 5, {})
-
-
-def dopri5_embedded_weights() -> np.ndarray:
-    """The embedded fourth-order weights b̂ of :func:`dopri5` (order checked on import)."""
-    return np.array(_DP_B_HAT)
 
 
 #: DOP853 (Hairer, Nørsett & Wanner I, II.10; the coefficients of Hairer's code DOP853, as
@@ -481,6 +475,3 @@ def as_scheme(scheme, **params) -> Scheme:
         )
     raise SchemeError(f"scheme must be a Scheme or a name, got {type(scheme).__name__}")
 
-
-# the embedded weights must be a fourth-order (and not fifth-order) companion of b
-assert tableau_order(np.array(_DP_A), np.array(_DP_B_HAT)) == 4

@@ -40,6 +40,36 @@ def adaptive_for(model, bound, multiplier: str = "ldl"):
                 lambda: _build_adaptive(kernels_for(model, bound, multiplier)))
 
 
+@njit(forceinline=True)
+def _next_step(t, h, target, taken, max_steps):
+    """The next attempted step from ``t`` with step size ``h``: ``(hh, hit, status)``, ``hh``
+    cut to end on the sample time ``target`` when it reaches it (``hit``); status
+    ``MAX_STEPS`` after ``taken ≥ max_steps`` steps, ``STEP_TOO_SMALL`` for a step below
+    roundoff at ``t``."""
+    if taken >= max_steps:
+        return h, False, _MAX_STEPS
+    hh = h
+    hit = False
+    if t + hh >= target - 1e-12 * abs(target):
+        hh = target - t
+        hit = True
+    if hh <= 1e-14 * max(1.0, abs(t)):
+        return hh, hit, _STEP_TOO_SMALL
+    return hh, hit, 0
+
+
+def _f_eval(rhs):
+    """One out-of-line copy of the (inlined) right-hand side, for the places that call it
+    once per step or per member: compiling the inlined body once instead of at each of
+    them halves the compile time."""
+
+    @njit(error_model="numpy")
+    def f_eval(t, x, p, law_mat, law_scal, ws, xdot):
+        return rhs(t, x, p, law_mat, law_scal, ws, xdot)
+
+    return f_eval
+
+
 def _first_step(f_eval, N2: int):
     """``first_step(t, x, k0, k1, xs, p, law_mat, law_scal, ws, rtol, atol, h0, tend, expo)``:
     ``h0`` when positive, otherwise the first step of Hairer, Nørsett & Wanner (II.4), from
@@ -96,12 +126,7 @@ def _adaptive_loop(K, save, label: str):
     rhs, project = K.rhs, K.project
     N2 = 2 * K.n
 
-    @njit(error_model="numpy")
-    def f_eval(t, x, p, law_mat, law_scal, ws, xdot):
-        # one out-of-line copy of the (inlined) right-hand side, called from three places:
-        # compiling the inlined body once instead of three times halves the compile time
-        return rhs(t, x, p, law_mat, law_scal, ws, xdot)
-
+    f_eval = _f_eval(rhs)
     first_step = _first_step(f_eval, N2)
 
     @njit(error_model="numpy")
@@ -129,17 +154,10 @@ def _adaptive_loop(K, save, label: str):
         after_reject = False
         while j < nsave:
             target = save_times[j]
-            if accepted + rejected >= max_steps:
+            hh, hit, st = _next_step(t, h, target, accepted + rejected, max_steps)
+            if st != 0:
                 counts[0], counts[1], counts[2] = accepted, rejected, nfev
-                return _MAX_STEPS, j + 1
-            hit = False
-            hh = h
-            if t + hh >= target - 1e-12 * abs(target):
-                hh = target - t
-                hit = True
-            if hh <= 1e-14 * max(1.0, abs(t)):
-                counts[0], counts[1], counts[2] = accepted, rejected, nfev
-                return _STEP_TOO_SMALL, j + 1
+                return st, j + 1
             # stages 1 … s−1 (stage 0 is ẋ at (t, x): first same as last)
             st = 0
             for i in range(1, s):
@@ -340,10 +358,7 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, B: int, n_params:
                      {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": ng, "math": math})
     attempt = njit(forceinline=True, error_model="numpy")(ns["attempt"])
 
-    @njit(error_model="numpy")
-    def f_eval(t, x, p, law_mat, law_scal, ws, xdot):
-        return rhs(t, x, p, law_mat, law_scal, ws, xdot)
-
+    f_eval = _f_eval(rhs)
     first_step = _first_step(f_eval, N2)
 
     @njit(nogil=True, error_model="numpy")
@@ -470,19 +485,10 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, B: int, n_params:
                         H[lane] = hh * max(0.2, 0.9 * e ** -expo)
                         after[lane] = True
                 if i >= 0 and st == 0:  # the next attempt: its step, or a stop
-                    target = save_times[jj[lane]]
-                    t = T[lane]
-                    if acc_n[lane] + rej_n[lane] >= max_steps:
-                        st = _MAX_STEPS
-                    else:
-                        hit[lane] = False
-                        hh = H[lane]
-                        if t + hh >= target - 1e-12 * abs(target):
-                            hh = target - t
-                            hit[lane] = True
-                        if hh <= 1e-14 * max(1.0, abs(t)):
-                            st = _STEP_TOO_SMALL
-                        HH[lane] = hh
+                    HH[lane], hit[lane], st = _next_step(T[lane], H[lane],
+                                                         save_times[jj[lane]],
+                                                         acc_n[lane] + rej_n[lane],
+                                                         max_steps)  # fmt: skip
                 if i >= 0 and st != 0:  # the member's end: its outputs
                     st = 0 if st == -1 else st
                     for l in range(N2):
@@ -542,16 +548,7 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, B: int, n_params:
                         h, nf = first_step(t0, x_h, k0_h, k1_h, xs_h, p, law_mat, law_scal,
                                            ws_h, rtol, atol, h0, tend, expo)  # fmt: skip
                         fev_n[lane] += nf
-                        hh = h
-                        hit[lane] = False
-                        target = save_times[0]
-                        if t0 + hh >= target - 1e-12 * abs(target):
-                            hh = target - t0
-                            hit[lane] = True
-                        if max_steps <= 0:
-                            st = _MAX_STEPS
-                        elif hh <= 1e-14 * max(1.0, abs(t0)):
-                            st = _STEP_TOO_SMALL
+                        hh, hit[lane], st = _next_step(t0, h, save_times[0], 0, max_steps)
                     if st != 0:
                         for l in range(N2):
                             x_final[i, l] = x_h[l]
