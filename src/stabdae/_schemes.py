@@ -22,6 +22,7 @@ compiled once per pattern of zero, unit and other coefficients.
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass
@@ -179,6 +180,7 @@ def tableau_order(A, b, max_order: int = 9, tol: float = 1e-12) -> int:
     return order
 
 
+@functools.cache  # immutable; checking DOP853's 286 order conditions takes milliseconds
 def euler() -> Scheme:
     """Explicit Euler (5.1), order 1."""
     return Scheme("euler", [[0.0]], [1.0], [0.0], 1, {})
@@ -222,16 +224,19 @@ def two_stage(a: float, sigma: float, *, name: str | None = None) -> Scheme:
     )
 
 
+@functools.cache
 def midpoint() -> Scheme:
     """Two-stage scheme with σ = 1, a = ½ (explicit midpoint rule), order 2."""
     return two_stage(0.5, 1.0, name="midpoint")
 
 
+@functools.cache
 def heun() -> Scheme:
     """Two-stage scheme with σ = ½, a = 1 (Heun's method), order 2."""
     return two_stage(1.0, 0.5, name="heun")
 
 
+@functools.cache
 def rk3() -> Scheme:
     """Kutta's third-order method (Hairer, Nørsett & Wanner I, II.1, Table 1.1): ``c = (0, ½,
     1)``, ``b = (1/6, 2/3, 1/6)``."""
@@ -239,6 +244,7 @@ def rk3() -> Scheme:
                   [1 / 6, 2 / 3, 1 / 6], [0.0, 0.5, 1.0], 3, {})  # fmt: skip
 
 
+@functools.cache
 def heun3() -> Scheme:
     """Heun's third-order method (Hairer, Nørsett & Wanner I, II.1, Table 1.1): ``c = (0,
     ⅓, ⅔)``, ``b = (¼, 0, ¾)``."""
@@ -246,6 +252,7 @@ def heun3() -> Scheme:
                   [0.25, 0.0, 0.75], [0.0, 1 / 3, 2 / 3], 3, {})  # fmt: skip
 
 
+@functools.cache
 def rk4() -> Scheme:
     """The classical fourth-order Runge–Kutta scheme."""
     A = [[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]]
@@ -268,6 +275,7 @@ _DP_B = [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0]
 _DP_B_HAT = [5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 187 / 2100, 1 / 40]
 
 
+@functools.cache
 def dopri5() -> Scheme:
     """Dormand–Prince 5(4), order 5 (the first-same-as-last 7-stage tableau).
 
@@ -341,6 +349,7 @@ def _d8_matrix() -> list:
     return A
 
 
+@functools.cache
 def dop853() -> Scheme:
     """Hairer's DOP853, order 8 (Hairer, Nørsett & Wanner I, II.10), as a fixed-step
     scheme: its twelve stages and eighth-order weights.  With adaptive steps
@@ -412,13 +421,18 @@ class EmbeddedPair:
         return self.scheme.name
 
 
+@functools.cache
+def _pair(name: str) -> EmbeddedPair:
+    if name == "dopri5":
+        return EmbeddedPair(dopri5(), np.array(_DP_B) - np.array(_DP_B_HAT), (4,), 4, False)
+    return EmbeddedPair(dop853(), [_D8_E5, _D8_E3], (5, 3), 7, True)
+
+
 def embedded_pair(scheme, who: str = "embedded_pair") -> EmbeddedPair:
     """The embedded pair of ``"dopri5"`` or ``"dop853"`` (a name or the :class:`Scheme`)."""
     name = scheme.name if isinstance(scheme, Scheme) else str(scheme).lower()
-    if name == "dopri5":
-        return EmbeddedPair(dopri5(), np.array(_DP_B) - np.array(_DP_B_HAT), (4,), 4, False)
-    if name == "dop853":
-        return EmbeddedPair(dop853(), [_D8_E5, _D8_E3], (5, 3), 7, True)
+    if name in ("dopri5", "dop853"):
+        return _pair(name)
     raise SchemeError(f"{who}: adaptive steps need an embedded pair, 'dopri5' (Dormand–Prince "
                       f"5(4)) or 'dop853' (Hairer's 8(5,3)); got {name!r}")
 

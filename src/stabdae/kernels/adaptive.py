@@ -16,6 +16,7 @@ sample times.  The pair's coefficients are run-time arrays: one compiled loop se
 
 from __future__ import annotations
 
+import hashlib
 import math
 
 import numpy as np
@@ -164,7 +165,8 @@ def _adaptive_loop(K, save, label: str):
                 for l in range(N2):
                     acc = 0.0
                     for m_ in range(i):
-                        acc += tab_a[i, m_] * k[m_, l]
+                        if tab_a[i, m_] != 0.0:  # zeros skipped, as the lanes skip them
+                            acc += tab_a[i, m_] * k[m_, l]
                     xs[l] = x[l] + hh * acc
                 st = f_eval(t + tab_c[i] * hh, xs, p, law_mat, law_scal, ws, k[i])
                 nfev += 1
@@ -175,7 +177,8 @@ def _adaptive_loop(K, save, label: str):
                 for l in range(N2):
                     acc = 0.0
                     for i in range(s):
-                        acc += tab_b[i] * k[i, l]
+                        if tab_b[i] != 0.0:
+                            acc += tab_b[i] * k[i, l]
                     xnew[l] = x[l] + hh * acc
                     if not math.isfinite(xnew[l]):
                         finite = False
@@ -192,11 +195,13 @@ def _adaptive_loop(K, save, label: str):
                     sc = atol + rtol * max(abs(x[l]), abs(xnew[l]))
                     acc5 = 0.0
                     for i in range(s_e):
-                        acc5 += tab_e[0, i] * k[i, l]
+                        if tab_e[0, i] != 0.0:
+                            acc5 += tab_e[0, i] * k[i, l]
                     if combined:
                         acc3 = 0.0
                         for i in range(s_e):
-                            acc3 += tab_e[1, i] * k[i, l]
+                            if tab_e[1, i] != 0.0:
+                                acc3 += tab_e[1, i] * k[i, l]
                         e5, e3 = acc5 / sc, acc3 / sc
                         s5 += e5 * e5
                         s3 += e3 * e3
@@ -290,53 +295,70 @@ def adaptive_block_for(model, bound, pair, lanes: int = LANES):
     s, s_e = pair.scheme.stages, pair.error.shape[1]
     shape = bound.matrix.shape
     n_params = len(model.param_names)
-    return memo(model, ("adaptive-block", bound.code, bound.fn, s, s_e, pair.combined, lanes,
-                        shape),
+    pattern = _pattern(pair)
+    return memo(model, ("adaptive-block", bound.code, bound.fn, s, s_e, pair.combined, pattern,
+                        lanes, shape),
                 lambda: _build_adaptive_block(kernels_for(model, bound), s, s_e,
-                                              pair.combined, lanes, n_params,
+                                              pair.combined, pattern, lanes, n_params,
                                               shape))  # fmt: skip
 
 
-def _attempt_source(s: int, s_e: int, combined: bool) -> str:
+def _pattern(pair) -> tuple:
+    """Which coefficients of a pair are not zero: (A's rows, b, the error weights' rows)."""
+    nz = lambda a: tuple(bool(v != 0.0) for v in a)  # noqa: E731
+    return (tuple(nz(row) for row in pair.scheme.A), nz(pair.scheme.b),
+            tuple(nz(row) for row in pair.error))  # fmt: skip
+
+
+def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple) -> str:
     """Python source of one lane's attempted step of an embedded pair with ``s`` stages
     and error weights over ``s_e`` stages (``s + 1``: ẋ at the new state evaluated too),
     the stages written out (no inner loop around the inlined right-hand sides, so the lane
-    loop around it vectorizes).  The sums run over every coefficient, zeros included, in
-    the order of :func:`_adaptive_loop`'s loops, so that each lane's numbers are those of
-    the single-trajectory loop bit for bit.  Every stage is evaluated (lanes do not
-    branch); ``nev`` counts those the single loop evaluates (up to the first failing one).
+    loop around it vectorizes).  The sums run over the coefficients that are not zero
+    (``pattern``, :func:`_pattern`), in the order of :func:`_adaptive_loop`'s loops, which
+    skip the same zeros, so that each lane's numbers are those of the single-trajectory
+    loop bit for bit.  (With DOP853's zeros in, LLVM left the lane loop scalar.)  Every
+    stage is evaluated (lanes do not branch); ``nev`` counts those the single loop
+    evaluates (up to the first failing one).
     Returns ``(good, nev, err, r)``: all evaluations succeeded and the new state and the
     error norm are finite; the error norm; ``‖g‖∞`` at the last evaluation (the new
     state)."""
+    a_nz, b_nz, e_nz = pattern
     lines = ["def attempt(t, hh, x, k0, p, law_mat, law_scal, tab_a, tab_b, tab_e, tab_c, rtol,",
              "            atol, ws, xs, xn, kl):"]
     lines += [f"    k{i} = stack1(N2)" for i in range(1, s_e)]
     lines += ["    ok = True", "    nev = 0"]
     for i in range(1, s):
         lines += ["    for l in range(N2):", "        acc = 0.0"]
-        lines += [f"        acc += tab_a[{i}, {m}] * k{m}[l]" for m in range(i)]
+        lines += [f"        acc += tab_a[{i}, {m}] * k{m}[l]" for m in range(i) if a_nz[i][m]]
         lines += ["        xs[l] = x[l] + hh * acc",
                   f"    c = rhs(t + tab_c[{i}] * hh, xs, p, law_mat, law_scal, ws, k{i})",
                   "    nev += ok", "    ok &= c == 0"]  # fmt: skip
     lines += ["    fin = True", "    for l in range(N2):", "        acc = 0.0"]
-    lines += [f"        acc += tab_b[{i}] * k{i}[l]" for i in range(s)]
+    lines += [f"        acc += tab_b[{i}] * k{i}[l]" for i in range(s) if b_nz[i]]
     lines += ["        xn[l] = x[l] + hh * acc", "        fin &= math.isfinite(xn[l])"]
     if s_e > s:
         lines += [f"    c = rhs(t + hh, xn, p, law_mat, law_scal, ws, k{s})",
                   "    nev += ok & fin", "    ok &= c == 0"]  # fmt: skip
-    lines += ["    s5 = 0.0", "    s3 = 0.0", "    for l in range(N2):",
-              "        sc = atol + rtol * max(abs(x[l]), abs(xn[l]))", "        acc5 = 0.0"]
-    lines += [f"        acc5 += tab_e[0, {i}] * k{i}[l]" for i in range(s_e)]
+    # the scale, then each estimate in a loop of its own: one loop over l with both
+    # estimates in it is too large for LLVM to unroll at n = 4 (the double pendulum), and
+    # the lane loop around a loop left rolled stays scalar.  Each sum still runs over l
+    # in order, as the single loop's.
+    lines += ["    sc = stack1(N2)", "    for l in range(N2):",
+              "        sc[l] = atol + rtol * max(abs(x[l]), abs(xn[l]))",
+              "    s5 = 0.0", "    for l in range(N2):", "        acc5 = 0.0"]  # fmt: skip
+    lines += [f"        acc5 += tab_e[0, {i}] * k{i}[l]" for i in range(s_e) if e_nz[0][i]]
     if combined:
-        lines += ["        acc3 = 0.0"]
-        lines += [f"        acc3 += tab_e[1, {i}] * k{i}[l]" for i in range(s_e)]
-        lines += ["        e5 = acc5 / sc", "        e3 = acc3 / sc", "        s5 += e5 * e5",
-                  "        s3 += e3 * e3",
-                  "    e = 0.0",
-                  "    if s5 != 0.0 or s3 != 0.0:",
-                  "        e = abs(hh) * s5 / math.sqrt((s5 + 0.01 * s3) * N2)"]  # fmt: skip
+        lines += ["        e5 = acc5 / sc[l]", "        s5 += e5 * e5",
+                  "    s3 = 0.0", "    for l in range(N2):", "        acc3 = 0.0"]  # fmt: skip
+        lines += [f"        acc3 += tab_e[1, {i}] * k{i}[l]" for i in range(s_e) if e_nz[1][i]]
+        lines += ["        e3 = acc3 / sc[l]", "        s3 += e3 * e3",
+                  # the loop's `if s5 or s3` as a select, so that the lane loop vectorizes:
+                  # s5 = 0 gives 0 either way, and NaN and inf give NaN either way
+                  "    den = (s5 + 0.01 * s3) * N2",
+                  "    e = abs(hh) * s5 / math.sqrt(den if den > 0.0 else 1.0)"]  # fmt: skip
     else:
-        lines += ["        e5 = hh * acc5 / sc", "        s5 += e5 * e5",
+        lines += ["        e5 = hh * acc5 / sc[l]", "        s5 += e5 * e5",
                   "    e = math.sqrt(s5 / N2)"]  # fmt: skip
     lines += ["    for l in range(N2):", f"        kl[l] = k{s_e - 1}[l]",
               "    r = 0.0", "    for l in range(NG):", "        r = max(r, abs(ws.g[l]))",
@@ -344,8 +366,8 @@ def _attempt_source(s: int, s_e: int, combined: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _build_adaptive_block(K, s: int, s_e: int, combined: bool, B: int, n_params: int,
-                          law_shape):  # fmt: skip
+def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B: int,
+                          n_params: int, law_shape):  # fmt: skip
     from .source import exec_source
     from .workspace import stack1, stack2, stack_int1
 
@@ -354,7 +376,8 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, B: int, n_params:
     N2, ng = 2 * K.n, K.ng
     NP = max(n_params, 1)
     LR, LC = law_shape
-    ns = exec_source(_attempt_source(s, s_e, combined), f"adaptive_attempt_{s}_{s_e}_{combined:d}",
+    label = f"{s}-{s_e}-{int(combined)}-{hashlib.sha1(repr(pattern).encode()).hexdigest()[:10]}"
+    ns = exec_source(_attempt_source(s, s_e, combined, pattern), f"adaptive_attempt_{label}",
                      {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": ng, "math": math})
     attempt = njit(forceinline=True, error_model="numpy")(ns["attempt"])
 
@@ -607,8 +630,6 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, B: int, n_params:
                 E[lane] = e
                 RN[lane] = r
 
-    tag(kernel_key(K.key, f"adaptive-block-{s}-{s_e}-{int(combined)}-{B}"), attempt, f_eval,
-        first_step)
-    keyed_cache(block_kernel, kernel_key(K.key, f"adaptive-block-{s}-{s_e}-{int(combined)}-{B}"
-                                         f"-{NP}-{LR}x{LC}"))
+    tag(kernel_key(K.key, f"adaptive-block-{label}-{B}"), attempt, f_eval, first_step)
+    keyed_cache(block_kernel, kernel_key(K.key, f"adaptive-block-{label}-{B}-{NP}-{LR}x{LC}"))
     return block_kernel

@@ -496,8 +496,8 @@ def grows(w2, w3, w4):
 
 
 # --------------------------------------------------------------------- per member
-@njit(cache=True)
-def observe(lt, lv, base, meas, j, row, t, v, d, window):
+@njit(cache=True, forceinline=True)  # once per accepted step: a call with four arrays
+def observe(lt, lv, base, meas, j, row, t, v, d, window):  # costs as much as the step
     """Step time ``t`` (from the start) of member ``row`` (ladder row ``j``), in fifth
     ``window`` of the run: ``v`` its residual norm (the largest per fifth is kept), ``d``
     the norm whose decay is measured (the ladder's; ``v`` itself, or the distance of the
