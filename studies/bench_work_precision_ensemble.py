@@ -11,7 +11,8 @@ given radii, seed 0), integrated under the Baumgarte law (ω, ξ = 1) to ``t_end
 * stabdae through the public API (``stabdae.ensemble``, no traces, one stored sample at
   the end), every thread: fixed steps with ``midpoint``, ``rk4``, ``dopri5`` and
   ``dop853`` over a ladder of steps, and adaptive steps with the pairs Dormand–Prince
-  5(4) and DOP853 over a ladder of tolerances (``atol = rtol``);
+  5(4) and DOP853 over a ladder of tolerances (``atol = rtol``); and fixed-step DOP853
+  again on one thread (cost per core against thread count);
 * heyoka's batch mode (``heyoka.taylor_adaptive_batch``, one member per SIMD lane, each
   lane with its own step), on the same stabilized ODE built from the scene's sympy spec
   (``kernels/specs``): M, γ, F and F's acceleration term derived by ``stabdae.symbolic``,
@@ -371,9 +372,10 @@ def run_scene(scene: Scene, members: int, repeat: int, quick: bool, diffrax_memb
                   save_dt=scene.t_end)  # fmt: skip
     rows, compile_s = [], {}
 
-    def stabdae_run(scheme, steps=None, rtol=None):
+    def stabdae_run(scheme, steps=None, rtol=None, threads=None):
         tau = scene.t_end / steps if steps else scene.t_end / 1000
-        return stabdae.ensemble(model, law, scheme, tau, scene.t_end, rtol=rtol, **common)
+        return stabdae.ensemble(model, law, scheme, tau, scene.t_end, rtol=rtol,
+                                threads=threads, **common)  # fmt: skip
 
     # the sampled initial states, and every scheme compiled before any timing
     for scheme in scene.fixed:
@@ -418,6 +420,11 @@ def run_scene(scene: Scene, members: int, repeat: int, quick: bool, diffrax_memb
         for rtol in ladder(scene.tols):
             ds, wall = best_time(partial(stabdae_run, pair, rtol=rtol), repeat)
             record("stabdae", f"{pair} adaptive", rtol, ds["x_final"].values, wall, threads)
+    if threads > 1:  # per core on one thread: DOP853, the cheapest family on every scene
+        for steps in ladder(scene.fixed["dop853"]):
+            ds, wall = best_time(partial(stabdae_run, "dop853", steps=steps, threads=1), repeat)
+            record("stabdae", "dop853 fixed, 1 thread", scene.t_end / steps,
+                   ds["x_final"].values, wall, 1)  # fmt: skip
     for tol in ladder(scene.heyoka_tols):
         ta, built = hy_.integrator(tol)
         compile_s[f"heyoka tol={tol:g}"] = built
