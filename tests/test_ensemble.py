@@ -782,3 +782,32 @@ def test_members_whose_floor_rises_keep_the_map_rate():
                           epsilon=1.0)  # fmt: skip
     assert (ds.fit_kind.values == decay.K_MAP).all()
     assert abs(float(ds.beta_median) / float(ds.beta_theory_discrete) - 1) < 1e-4
+
+
+def test_roundoff_level_of_the_pendulum_is_its_closed_form():
+    """The residual's roundoff level at a state is u · max_c Σ_i |∂g_c/∂x_i · x_i|; for the
+    pendulum's f = x² + y² − l², ḟ = 2(x ẋ + y ẏ) the sums are 2(x² + y²) and
+    4(|x ẋ| + |y ẏ|) (central differences are exact on quadratics up to rounding), and the
+    level of several states is the median of theirs; all states are differenced in one
+    call."""
+    from stabdae import _ensemble, _measures
+
+    model = load_scene("pendulum")
+    p = model.param_vector(None)
+    X = np.random.default_rng(3).normal(size=(5, 4))
+    calls = []
+
+    def rows(Y, at):
+        calls.append(Y.shape[0])
+        return _ensemble._residual_rows(model, np.ascontiguousarray(Y), p, at)
+
+    u = np.finfo(float).eps / 2.0
+    x, y, vx, vy = X.T
+    each = np.maximum(2.0 * (x * x + y * y), 4.0 * (np.abs(x * vx) + np.abs(y * vy)))
+    got = _measures.roundoff_level(rows, X, 0.7)
+    assert got == pytest.approx(u * np.median(each), rel=1e-6)
+    assert calls == [5 * 9, 5]  # the differences of every state, then the time shifts
+    for i in range(5):
+        assert _measures.roundoff_level(rows, X[i : i + 1], 0.7) == pytest.approx(
+            u * each[i], rel=1e-6)
+    assert _measures.roundoff_level(rows, X[:0], 0.7) == 0.0

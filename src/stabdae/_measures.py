@@ -103,18 +103,22 @@ def roundoff_level(residual_rows, states, t: float) -> float:
         return 0.0
     h = 1e-6
     u = np.finfo(float).eps / 2.0
+    states = np.atleast_2d(states)
+    S, n2 = states.shape
+    rows = 2 * n2 + 1  # per state: ± each entry, then the state itself
+    X = np.repeat(states, rows, axis=0).reshape(S, rows, n2)
+    idx = np.arange(n2)
+    X[:, 2 * idx, idx] += h * states
+    X[:, 2 * idx + 1, idx] -= h * states
+    # every state's rows in one call (each call is a trip to the threads)
+    G = residual_rows(X.reshape(S * rows, n2), t).reshape(S, rows, -1)
+    if t != 0.0:
+        Gt = residual_rows(np.ascontiguousarray(X[:, -1]), t * (1.0 + h))
     levels = []
-    for x in states:
-        n2 = x.size
-        X = np.repeat(x[None, :], 2 * n2 + 1, axis=0)
-        idx = np.arange(n2)
-        X[2 * idx, idx] += h * x
-        X[2 * idx + 1, idx] -= h * x
-        G = residual_rows(X, t)
-        terms = np.abs(G[0:-1:2] - G[1:-1:2]).sum(axis=0) / (2.0 * h)
+    for i in range(S):
+        terms = np.abs(G[i, 0:-1:2] - G[i, 1:-1:2]).sum(axis=0) / (2.0 * h)
         if t != 0.0:
-            Gt = residual_rows(X[-1:], t * (1.0 + h))[0]
-            terms = terms + np.abs(Gt - G[-1]) / h
+            terms = terms + np.abs(Gt[i] - G[i, -1]) / h
         if np.all(np.isfinite(terms)):
             levels.append(float(terms.max()) if terms.size else 0.0)
     return u * float(np.median(levels)) if levels else 0.0
