@@ -232,10 +232,8 @@ class Heyoka:
 
         self.hy, self.system, self.t_end = hy, system, t_end
         self.batch = hy.recommended_simd_size()
-        M = x0.shape[0]
-        self.pad = -M % self.batch
-        self.x0 = np.concatenate([x0, np.repeat(x0[-1:], self.pad, axis=0)])
-        self.M = M
+        self.M = x0.shape[0]  # padded to whole batches with copies of the last member
+        self.x0 = np.concatenate([x0, np.repeat(x0[-1:], -self.M % self.batch, axis=0)])
 
     def integrator(self, tol, high_accuracy=False):
         clock = time.perf_counter()
@@ -244,15 +242,19 @@ class Heyoka:
             high_accuracy=high_accuracy)  # fmt: skip
         return ta, time.perf_counter() - clock
 
-    def one_thread(self, ta):
-        out = np.empty_like(self.x0)
+    def _batches(self, ta, lo, hi, out):
+        """Members ``lo … hi − 1`` (whole batches) through one integrator, into ``out``."""
         B = self.batch
-        for i in range(0, self.x0.shape[0], B):
+        for i in range(lo, hi, B):
             ta.set_time(0.0)
             ta.state[:] = self.x0[i : i + B].T
             ta.propagate_until(self.t_end)
             _check_outcomes(ta)
             out[i : i + B] = ta.state.T
+
+    def one_thread(self, ta):
+        out = np.empty_like(self.x0)
+        self._batches(ta, 0, self.x0.shape[0], out)
         return out[: self.M]
 
     def threaded(self, ta, threads):
@@ -261,19 +263,12 @@ class Heyoka:
         from concurrent.futures import ThreadPoolExecutor
         from copy import deepcopy
 
-        B, x0 = self.batch, self.x0
-        nb = x0.shape[0] // B
-        bounds = np.linspace(0, nb, threads + 1).astype(int) * B
-        out = np.empty_like(x0)
+        B = self.batch
+        bounds = np.linspace(0, self.x0.shape[0] // B, threads + 1).astype(int) * B
+        out = np.empty_like(self.x0)
 
         def work(k):
-            local = self._copies[k]
-            for i in range(bounds[k], bounds[k + 1], B):
-                local.set_time(0.0)
-                local.state[:] = x0[i : i + B].T
-                local.propagate_until(self.t_end)
-                _check_outcomes(local)
-                out[i : i + B] = local.state.T
+            self._batches(self._copies[k], bounds[k], bounds[k + 1], out)
 
         if getattr(self, "_copied", None) is not ta:
             self._copies, self._copied = [deepcopy(ta) for _ in range(threads)], ta

@@ -59,6 +59,31 @@ def _next_step(t, h, target, taken, max_steps):
     return hh, hit, 0
 
 
+@njit(forceinline=True)
+def _combined_norm(s5, s3, hh, N2):
+    """DOP853's error norm ‖e₅‖² / √(‖e₅‖² + 0.01 ‖e₃‖²) from the sums of squares of the
+    scaled estimates: 0 when both are 0 (a select, not a branch, so that the lanes'
+    loop vectorizes; 0 for s5 = 0 and NaN for NaN or inf either way)."""
+    den = (s5 + 0.01 * s3) * N2
+    return abs(hh) * s5 / math.sqrt(den if den > 0.0 else 1.0)
+
+
+@njit(forceinline=True)
+def _settle(good, e, hh, h, hit, after_reject, expo):
+    """The step control after an attempt of size ``hh`` (``h``: the step before a cut to a
+    sample time, ``hit``): ``(accepted, next h, after_reject)``.  A failed or non-finite
+    attempt shrinks hard; ``e ≤ 1`` accepts and grows by ``0.9 e^{−1/(q+1)}`` within
+    ``[0.2, 10]``, not at all right after a rejection; ``e > 1`` shrinks by that factor."""
+    if not good:
+        return False, 0.25 * hh, True
+    if e <= 1.0:
+        fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e**-expo))
+        if after_reject:
+            fac = min(fac, 1.0)
+        return True, (hh * fac if not hit else max(h, hh * fac)), False
+    return False, hh * max(0.2, 0.9 * e**-expo), True
+
+
 def _f_eval(rhs):
     """One out-of-line copy of the (inlined) right-hand side, for the places that call it
     once per step or per member: compiling the inlined body once instead of at each of
@@ -208,18 +233,11 @@ def _adaptive_loop(K, save, label: str):
                     else:
                         e5 = hh * acc5 / sc
                         s5 += e5 * e5
-                if combined:
-                    if s5 != 0.0 or s3 != 0.0:
-                        e = abs(hh) * s5 / math.sqrt((s5 + 0.01 * s3) * N2)
-                else:
-                    e = math.sqrt(s5 / N2)
+                e = _combined_norm(s5, s3, hh, N2) if combined else math.sqrt(s5 / N2)
                 finite = math.isfinite(e)
-            if not finite:  # a failed evaluation or overflow: shrink hard and retry
-                rejected += 1
-                h = 0.25 * hh
-                after_reject = True
-                continue
-            if e <= 1.0:
+            # (a failed evaluation or overflow: shrink hard and retry)
+            ok, h, after_reject = _settle(finite, e, hh, h, hit, after_reject, expo)
+            if ok:
                 accepted += 1
                 t = target if hit else t + hh
                 for l in range(N2):
@@ -233,11 +251,6 @@ def _adaptive_loop(K, save, label: str):
                     if st != 0:
                         counts[0], counts[1], counts[2] = accepted, rejected, nfev
                         return st, j + 1
-                fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e ** -expo))
-                if after_reject:
-                    fac = min(fac, 1.0)
-                after_reject = False
-                h = hh * fac if not hit else max(h, hh * fac)
                 if hit:
                     j += 1
                     if save(j, t, x, p, ws, g, out):
@@ -245,8 +258,6 @@ def _adaptive_loop(K, save, label: str):
                         return _DIVERGED, j + 1
             else:
                 rejected += 1
-                h = hh * max(0.2, 0.9 * e ** -expo)
-                after_reject = True
         counts[0], counts[1], counts[2] = accepted, rejected, nfev
         return 0, nsave + 1
 
@@ -353,10 +364,7 @@ def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple) -> str:
                   "    s3 = 0.0", "    for l in range(N2):", "        acc3 = 0.0"]  # fmt: skip
         lines += [f"        acc3 += tab_e[1, {i}] * k{i}[l]" for i in range(s_e) if e_nz[1][i]]
         lines += ["        e3 = acc3 / sc[l]", "        s3 += e3 * e3",
-                  # the loop's `if s5 or s3` as a select, so that the lane loop vectorizes:
-                  # s5 = 0 gives 0 either way, and NaN and inf give NaN either way
-                  "    den = (s5 + 0.01 * s3) * N2",
-                  "    e = abs(hh) * s5 / math.sqrt(den if den > 0.0 else 1.0)"]  # fmt: skip
+                  "    e = combined_norm(s5, s3, hh, N2)"]  # fmt: skip
     else:
         lines += ["        e5 = hh * acc5 / sc[l]", "        s5 += e5 * e5",
                   "    e = math.sqrt(s5 / N2)"]  # fmt: skip
@@ -369,7 +377,7 @@ def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple) -> str:
 def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B: int,
                           n_params: int, law_shape):  # fmt: skip
     from .source import exec_source
-    from .workspace import stack1, stack2, stack_int1
+    from .workspace import copy_inputs, stack1, stack2, stack_int1
 
     rhs, residual, energy = K.rhs, K.residual, K.energy
     make_workspace, stack_workspace = K.make_workspace, K.stack_workspace
@@ -378,7 +386,8 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
     LR, LC = law_shape
     label = f"{s}-{s_e}-{int(combined)}-{hashlib.sha1(repr(pattern).encode()).hexdigest()[:10]}"
     ns = exec_source(_attempt_source(s, s_e, combined, pattern), f"adaptive_attempt_{label}",
-                     {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": ng, "math": math})
+                     {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": ng, "math": math,
+                      "combined_norm": _combined_norm})
     attempt = njit(forceinline=True, error_model="numpy")(ns["attempt"])
 
     f_eval = _f_eval(rhs)
@@ -400,16 +409,11 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
         nsave = save_times.shape[0]
         tend = save_times[nsave - 1]
         span = tend - t0
-        # the small run-time inputs on the stack (see the fixed-step kernel: no aliasing)
+        # the small run-time inputs on the stack (copy_inputs: no aliasing)
         p_s = stack1(NP)
-        for i in range(min(p.shape[0], NP)):
-            p_s[i] = p[i]
         lm = stack2(LR, LC)
-        for i in range(LR):
-            for j in range(LC):
-                lm[i, j] = law_mat[i, j]
         ls = stack1(1)
-        ls[0] = law_scal[0]
+        copy_inputs(p, law_mat, law_scal, p_s, lm, ls)
         ta = stack2(s, s)
         tb = stack1(s)
         tc = stack1(s)
@@ -467,12 +471,9 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
                 if i >= 0 and HH[lane] > 0.0:  # an attempt was made
                     fev_n[lane] += NEV[lane]
                     hh = HH[lane]
-                    e = E[lane]
-                    if not GOOD[lane]:
-                        rej_n[lane] += 1
-                        H[lane] = 0.25 * hh
-                        after[lane] = True
-                    elif e <= 1.0:
+                    ok, H[lane], after[lane] = _settle(GOOD[lane] != 0, E[lane], hh, H[lane],
+                                                       hit[lane], after[lane], expo)
+                    if ok:
                         acc_n[lane] += 1
                         t = save_times[jj[lane]] if hit[lane] else T[lane] + hh
                         T[lane] = t
@@ -482,11 +483,6 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
                         window = min(4, int(5.0 * (t - t0) / span))
                         observe(lt, lv, base, meas, lane, i, t - t0, RN[lane], RN[lane],
                                 window)  # fmt: skip
-                        fac = 10.0 if e == 0.0 else min(10.0, max(0.2, 0.9 * e ** -expo))
-                        if after[lane]:
-                            fac = min(fac, 1.0)
-                        after[lane] = False
-                        H[lane] = hh * fac if not hit[lane] else max(H[lane], hh * fac)
                         if hit[lane]:
                             jj[lane] += 1
                             for l in range(N2):
@@ -505,8 +501,6 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
                                 st = -1  # done
                     else:
                         rej_n[lane] += 1
-                        H[lane] = hh * max(0.2, 0.9 * e ** -expo)
-                        after[lane] = True
                 if i >= 0 and st == 0:  # the next attempt: its step, or a stop
                     HH[lane], hit[lane], st = _next_step(T[lane], H[lane],
                                                          save_times[jj[lane]],

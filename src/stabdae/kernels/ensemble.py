@@ -73,7 +73,7 @@ from .decay import (
 from .fma import fma
 from .rhs import kernels_for
 from .source import exec_source
-from .workspace import stack1, stack2, stack_int1
+from .workspace import copy_inputs, stack1, stack2, stack_int1
 
 BLOCK = 64
 #: the ensemble kernel checks the block at least this often (steps) and keeps a copy of it
@@ -312,17 +312,11 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         that fill them.  Releases the GIL (run by :func:`.threads.run_chunks`)."""
         M = x0s.shape[0]
         nsave = out_norm.shape[1]
-        # The small run-time inputs copied to the stack, so that the loops read memory no
-        # store of theirs can touch (loads hoisted, no run-time alias checks).
+        # the small run-time inputs on the stack (copy_inputs: no aliasing)
         p_s = stack1(NP)
-        for i in range(min(p.shape[0], NP)):  # (the driver passes exactly NP)
-            p_s[i] = p[i]
         lm = stack2(LR, LC)
-        for i in range(LR):
-            for j in range(LC):
-                lm[i, j] = law_mat[i, j]
         ls = stack1(1)
-        ls[0] = law_scal[0]
+        copy_inputs(p, law_mat, law_scal, p_s, lm, ls)
         ta = stack2(S_, S_)
         tb = stack1(S_)
         tc = stack1(S_)

@@ -28,7 +28,8 @@ from numba.extending import intrinsic
 
 from .source import exec_source
 
-__all__ = ["LAYOUT", "Workspace", "builders", "sizes", "stack1", "stack2", "stack_int1"]
+__all__ = ["LAYOUT", "Workspace", "builders", "copy_inputs", "sizes", "stack1", "stack2",
+           "stack_int1"]
 
 #: (name, shape in the sizes of :func:`sizes`, what it holds)
 LAYOUT = (
@@ -182,3 +183,16 @@ no NRT), valid only inside the function that calls it."""
 stack2.__doc__ = """A C-ordered float64 array of compile-time shape ``(n0, n1)`` on the
 stack."""
 stack_int1.__doc__ = """An int64 array of compile-time length ``n`` on the stack."""
+
+
+@njit(forceinline=True)
+def copy_inputs(p, law_mat, law_scal, p_s, lm, ls):
+    """Copy the ensemble kernels' small run-time inputs (parameters, the law's matrix and
+    scalar) into the caller's stack arrays ``p_s``, ``lm``, ``ls``: the loops then read
+    memory no store of theirs can touch (loads hoisted, no run-time alias checks)."""
+    for i in range(min(p.shape[0], p_s.shape[0])):  # (the drivers pass exactly p_s's size)
+        p_s[i] = p[i]
+    for i in range(lm.shape[0]):
+        for j in range(lm.shape[1]):
+            lm[i, j] = law_mat[i, j]
+    ls[0] = law_scal[0]
