@@ -284,6 +284,45 @@ def test_adaptive_lanes_refill_and_stay_bit_identical(pair):
         np.testing.assert_array_equal(ds[name].values, other[name].values)
 
 
+def test_adaptive_prediction_wakes_no_lapack_solve(monkeypatch):
+    """The adaptive ensemble's prediction propagator ``e^{Ãh}`` is formed by matrix
+    products only: LAPACK's solves (``scipy.linalg.expm`` makes them) wake the BLAS
+    library's threads, which then spin on the cores the ensemble's threads run on.
+    Every member still gets a predicted β, at the law's rate ω = 10."""
+    import scipy.linalg
+
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a LAPACK solve in the ensemble's own path")
+
+    for mod, name in ((scipy.linalg, "expm"), (scipy.linalg, "solve"),
+                      (scipy.linalg, "lu_factor"), (np.linalg, "solve"), (np.linalg, "inv")):
+        monkeypatch.setattr(mod, name, refuse)
+    ds = stabdae.ensemble(model, law, "dopri5", tau=1e-3, t_end=2.0, members=16,
+                          radius=(1e-6, 1e-3), seed=2, rtol=1e-8, atol=1e-10)  # fmt: skip
+    fitted = ds.beta_reason.values == decay.R_FITTED
+    assert fitted.sum() >= 12
+    np.testing.assert_allclose(ds.beta_predicted.values[fitted], 10.0, rtol=0.01)
+
+
+def test_expm_by_products_is_scipys_to_roundoff():
+    """``theory._expm`` (products only) against SciPy's Padé ``expm``: a critically
+    damped law over one prediction step, a stiff one, a random 6 × 6 and zero."""
+    import scipy.linalg
+
+    from stabdae import theory
+
+    rng = np.random.default_rng(4)
+    cases = [np.array([[0.0, 1.0], [-100.0, -20.0]]) * 2.4e-3,
+             np.array([[0.0, 7.3e-6], [-730.0, -0.146]]), 3.0 * rng.normal(size=(6, 6)),
+             np.zeros((3, 3))]  # fmt: skip
+    for A in cases:
+        ref = scipy.linalg.expm(A)
+        assert np.abs(theory._expm(A) - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
 def test_adaptive_ensemble_beta_and_determinism():
     """Continuous-time decay: at tight tolerance the median fitted β is the Theorem 3 rate
     (no discrete prediction is stored); one or two threads give the same numbers."""
@@ -551,6 +590,46 @@ def test_refined_shift_gives_the_repeated_eigenvalue_rate(c0):
     meas = decay.measure_traces(trace[None, :], t)
     assert meas[0, decay.C_KIND] == decay.K_POLYNOMIAL
     assert abs(meas[0, decay.C_BETA] / 10.0 - 1) < 0.002
+
+
+def test_log_normal_is_the_library_logarithm_to_an_ulp():
+    """The branch-free logarithm the fits use (so that their loops vectorize) agrees with
+    the C library's to one unit in the last place over the whole normal range, and is
+    exact at 1."""
+    from numba import njit
+
+    from stabdae.kernels import decay
+
+    @njit
+    def logs(x, out):
+        for i in range(x.shape[0]):
+            out[i] = decay.log_normal(x[i])
+
+    rng = np.random.default_rng(7)
+    x = np.concatenate([np.exp(rng.uniform(-708.0, 709.0, 200_000)),
+                        rng.uniform(0.5, 2.0, 200_000), 1.0 + rng.uniform(-1e-6, 1e-6, 10_000),
+                        [1.0, 2.0, 0.5, np.sqrt(0.5), np.sqrt(2.0), 2.2250738585072014e-308,
+                         1.7976931348623157e308]])  # fmt: skip
+    got = np.empty_like(x)
+    logs(x, got)
+    ref = np.log(x)
+    assert (got[x == 1.0] == 0.0).all()
+    nz = ref != 0.0
+    assert (np.abs(got - ref)[nz] <= np.spacing(np.abs(ref[nz]))).all()
+
+
+@pytest.mark.parametrize("shift", [0.05, 2.0])
+def test_log_prefactor_fit_recovers_an_exact_model(shift):
+    """``log ‖g‖ = c − βt + ν log(t + s)`` sampled without noise: the fit at that shift
+    returns its β to 1e-9 and a zero sum of squares."""
+    from stabdae.kernels import decay
+
+    t = np.linspace(0.3, 1.5, 40)
+    y = 0.7 - 9.5 * t + 1.0 * np.log(t + shift)
+    rt, ry, a, b, lg = decay.scratch()
+    rt[:40], ry[:40] = t, y
+    beta, sse = decay._fit_with_log(rt, ry, 0, 40, shift, a, b, lg)
+    assert abs(beta - 9.5) < 1e-9 and sse < 1e-20
 
 
 def test_no_transient_or_growth_gives_no_rate_and_says_why():

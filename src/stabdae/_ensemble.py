@@ -389,10 +389,8 @@ def _prediction(law, model, scheme, tau, span):
         return np.zeros((0, 0)), 1.0
     A = np.asarray(law.A_tilde(model), dtype=float)
     if tau is None:
-        from scipy.linalg import expm
-
         h = span / PREDICTION_STEPS
-        return np.ascontiguousarray(expm(A * h)), h
+        return np.ascontiguousarray(theory._expm(A * h)), h
     return np.ascontiguousarray(theory.step_matrix(A, scheme, tau)), tau
 
 
