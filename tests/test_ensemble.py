@@ -632,6 +632,22 @@ def test_log_prefactor_fit_recovers_an_exact_model(shift):
     assert abs(beta - 9.5) < 1e-9 and sse < 1e-20
 
 
+def test_log_prefactor_fit_outside_the_normal_range_is_least_squares():
+    """A shift that puts t + s below the normal floats (t from 0, s = 1e-310) takes the
+    library's logarithm: the fit is then numpy's least squares on the same columns."""
+    from stabdae.kernels import decay
+
+    t = np.linspace(0.0, 1.0, 30)
+    y = 0.3 - 4.0 * t + 0.01 * np.sin(7.0 * t)
+    rt, ry, a, b, lg = decay.scratch()
+    rt[:30], ry[:30] = t, y
+    beta, sse = decay._fit_with_log(rt, ry, 0, 30, 1e-310, a, b, lg)
+    X = np.column_stack([np.ones(30), -t, np.log(t + 1e-310)])
+    coef, res = np.linalg.lstsq(X, y, rcond=None)[:2]
+    assert abs(beta - coef[1]) < 1e-9 * abs(coef[1])
+    assert abs(sse - res[0]) < 1e-6 * res[0]
+
+
 def test_no_transient_or_growth_gives_no_rate_and_says_why():
     """A trace that sits on its floor, and one that grows, get β = NaN with their
     reasons, never a fitted number."""
