@@ -628,8 +628,53 @@ def test_log_prefactor_fit_recovers_an_exact_model(shift):
     y = 0.7 - 9.5 * t + 1.0 * np.log(t + shift)
     rt, ry, a, b, lg = decay.scratch()
     rt[:40], ry[:40] = t, y
-    beta, sse = decay._fit_with_log(rt, ry, 0, 40, shift, a, b, lg)
+    beta, sse = decay._fit_with_log(rt, ry, 0, 40, shift, a, b, lg,
+                                    decay._shift_free_sums(rt, ry, 0, 40))
     assert abs(beta - 9.5) < 1e-9 and sse < 1e-20
+
+
+@pytest.mark.parametrize("hint", [2.0, 2.3, 1e-3, 40.0, math.nan])
+def test_log_prefactor_search_from_a_hint_finds_the_grids_minimum(hint):
+    """The prediction's shift search starts at the measured member's shift: from a hint
+    near the true shift (2.0) it finds the exact model's β; from a hint far off (the
+    minimum on its bracket's edge) it falls back to the whole grid, as with no hint."""
+    from stabdae.kernels import decay
+
+    t = np.linspace(0.3, 1.5, 40)
+    y = 0.7 - 9.5 * t + 1.0 * np.log(t + 2.0)
+    rt, ry, a, b, lg = decay.scratch()
+    rt[:40], ry[:40] = t, y
+    beta, sse, shift = decay._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg, hint)
+    grid = decay._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg)
+    assert abs(beta - 9.5) < 1e-6 and abs(shift - 2.0) < 1e-3
+    assert abs(beta - grid[0]) < 1e-6
+
+
+def test_envelope_logarithms_are_the_librarys():
+    """The envelope's log norms (a vectorized logarithm over the row): within an ulp of
+    numpy's on normal norms; a row with a zero norm (−inf) or one below the normal floats
+    takes the library's log for every point."""
+    from stabdae.kernels import decay
+
+    lt, lv, _ = decay.ladders(3)
+    rt, ry = np.empty(decay.NBINS), np.empty(decay.NBINS)
+    k = np.arange(40)
+    for j, last in enumerate([None, 0.0, 1e-310]):
+        v = np.geomspace(1e3, 1e-200, 40)  # a decay: level 139 - k visited last at time k
+        if last is not None:
+            v[-1] = last
+        lt[j, :] = -1.0
+        lt[j, 139 - k] = k
+        lv[j, 139 - k] = v
+        n = decay.records(lt, lv, j, rt, ry)
+        assert n == 40 and (rt[:n] == k).all()
+        with np.errstate(divide="ignore"):
+            ref = np.log(v)
+        if last is None:
+            assert (np.abs(ry[:n] - ref) <= np.spacing(np.abs(ref))).all()
+        else:
+            assert (ry[:n] == ref).all()
+            assert ry[n - 1] == (-np.inf if last == 0.0 else math.log(1e-310))
 
 
 def test_log_prefactor_fit_outside_the_normal_range_is_least_squares():
@@ -641,7 +686,8 @@ def test_log_prefactor_fit_outside_the_normal_range_is_least_squares():
     y = 0.3 - 4.0 * t + 0.01 * np.sin(7.0 * t)
     rt, ry, a, b, lg = decay.scratch()
     rt[:30], ry[:30] = t, y
-    beta, sse = decay._fit_with_log(rt, ry, 0, 30, 1e-310, a, b, lg)
+    beta, sse = decay._fit_with_log(rt, ry, 0, 30, 1e-310, a, b, lg,
+                                    decay._shift_free_sums(rt, ry, 0, 30))
     X = np.column_stack([np.ones(30), -t, np.log(t + 1e-310)])
     coef, res = np.linalg.lstsq(X, y, rcond=None)[:2]
     assert abs(beta - coef[1]) < 1e-9 * abs(coef[1])

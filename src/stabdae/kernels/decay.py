@@ -242,10 +242,22 @@ def records(lt, lv, j, rt, ry):
         t = lt[j, b]
         if t > latest:
             latest = t
-            v = lv[j, b]
             rt[n] = t
-            ry[n] = math.log(v) if v > 0.0 else -math.inf
+            ry[n] = lv[j, b]
             n += 1
+    # the logarithms in a loop of their own, which vectorizes (a row with a norm below
+    # the normal floats, or a zero, takes the library's log)
+    normal = True
+    for i in range(n):
+        v = ry[i]
+        normal &= (v >= _TINY) & (v < math.inf)
+    if normal:
+        for i in range(n):
+            ry[i] = log_normal(ry[i])
+    else:
+        for i in range(n):
+            v = ry[i]
+            ry[i] = math.log(v) if v > 0.0 else -math.inf
     return n
 
 
@@ -320,9 +332,33 @@ def _fit_inverse(rt, ry, start, end):
 
 
 @njit(cache=True)
-def _fit_with_log(rt, ry, start, end, shift, a, b, lg):
+def _shift_free_sums(rt, ry, start, end):
+    """The sums of the ``ν log(t + s)`` fit's normal equations that do not depend on the
+    shift (the count, ``Σ −t``, ``Σ t²``, ``Σ y``, ``Σ −t y`` on [start, end)): formed once
+    per search of the shift, in the order the fit would form them."""
+    s00 = s01 = s11 = b0 = b1 = 0.0
+    for i in range(start, end):
+        r1 = -rt[i]
+        s00 += 1.0
+        s01 += r1
+        s11 += r1 * r1
+        b0 += ry[i]
+        b1 += r1 * ry[i]
+    return s00, s01, s11, b0, b1
+
+
+@njit(cache=True, forceinline=True)
+def _residual2(rt, ry, lg, i, c0, c1, c2):
+    """The squared residual of point ``i`` of the fit ``y ≈ c0 − c1 t + c2 log(t + s)``."""
+    r = ry[i] - c0 + c1 * rt[i] - c2 * lg[i]
+    return r * r
+
+
+@njit(cache=True)
+def _fit_with_log(rt, ry, start, end, shift, a, b, lg, fixed):
     """Least squares ``y ≈ c − β t + ν log(t + shift)`` on [start, end); returns (β, SSE),
-    SSE = inf when the normal equations are singular.  ``lg`` is scratch."""
+    SSE = inf when the normal equations are singular.  ``fixed``: the shift-free sums
+    (:func:`_shift_free_sums`); ``lg`` is scratch."""
     # the logarithms first, in a loop of their own that vectorizes (they are most of a
     # fit's cost, and a member's fits take some fifty shifts); the times are increasing
     if rt[start] + shift >= _TINY and rt[end - 1] + shift < math.inf:
@@ -332,18 +368,13 @@ def _fit_with_log(rt, ry, start, end, shift, a, b, lg):
         for i in range(start, end):
             lg[i] = math.log(rt[i] + shift)
     # the sums in locals (in arrays, every term was a store and a load: they may alias)
-    s00 = s01 = s02 = s11 = s12 = s22 = b0 = b1 = b2 = 0.0
+    s00, s01, s11, b0, b1 = fixed
+    s02 = s12 = s22 = b2 = 0.0
     for i in range(start, end):
-        t = rt[i]
-        r1, r2 = -t, lg[i]
-        s00 += 1.0
-        s01 += r1
+        r2 = lg[i]
         s02 += r2
-        s11 += r1 * r1
-        s12 += r1 * r2
+        s12 += -rt[i] * r2
         s22 += r2 * r2
-        b0 += ry[i]
-        b1 += r1 * ry[i]
         b2 += r2 * ry[i]
     a[0, 0], a[0, 1], a[0, 2] = s00, s01, s02
     a[1, 0], a[1, 1], a[1, 2] = s01, s11, s12
@@ -352,15 +383,23 @@ def _fit_with_log(rt, ry, start, end, shift, a, b, lg):
     if not _solve3(a, b):
         return math.nan, math.inf
     c0, c1, c2 = b[0], b[1], b[2]
-    sse = 0.0
-    for i in range(start, end):
-        r = ry[i] - c0 + c1 * rt[i] - c2 * lg[i]
-        sse += r * r
-    return c1, sse
+    # four partial sums (a single chain of additions waits on each one in turn)
+    e0 = e1 = e2 = e3 = 0.0
+    i = start
+    while i + 4 <= end:
+        e0 += _residual2(rt, ry, lg, i, c0, c1, c2)
+        e1 += _residual2(rt, ry, lg, i + 1, c0, c1, c2)
+        e2 += _residual2(rt, ry, lg, i + 2, c0, c1, c2)
+        e3 += _residual2(rt, ry, lg, i + 3, c0, c1, c2)
+        i += 4
+    while i < end:
+        e0 += _residual2(rt, ry, lg, i, c0, c1, c2)
+        i += 1
+    return c1, (e0 + e1) + (e2 + e3)
 
 
 @njit(cache=True)
-def _brent(rt, ry, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg):
+def _brent(rt, ry, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg, fixed):
     """Brent's minimization (parabolic steps, golden sections when they fail) of the
     ``ν log(t + s)`` fit's SSE over ``u = log(s + t_w)`` in ``[lo_u, hi_u]``, from the
     grid's best point ``x`` (SSE ``fx``, β ``bx``), to ``BRENT_TOL`` of the bracket.
@@ -398,7 +437,7 @@ def _brent(rt, ry, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg):
             e = (lo - x) if x >= xm else (hi - x)
             d = CG * e
         u = x + d if abs(d) >= tol1 else x + (tol1 if d >= 0.0 else -tol1)
-        bu, fu = _fit_with_log(rt, ry, start, end, math.exp(u) - t_w, a, b, lg)
+        bu, fu = _fit_with_log(rt, ry, start, end, math.exp(u) - t_w, a, b, lg, fixed)
         if fu < best:
             best, beta, ubest = fu, bu, u
         if fu <= fx:
@@ -423,21 +462,36 @@ def _brent(rt, ry, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg):
 
 
 @njit(cache=True)
-def _fit_polynomial(rt, ry, start, end, dt, a, b, lg):
+def _fit_polynomial(rt, ry, start, end, dt, a, b, lg, hint=math.nan):
     """The ``ν log(t + s)`` fit with the best shift: a log-spaced grid of shifts
     ``s = e^u − t_w`` over ``(−t_w, ∞)`` (``t_w`` the window's first time: a negative
     ``s`` puts a zero crossing of ``c0 + c1 t`` just before the window), refined by
-    Brent's method around the best grid point.  Returns (β, SSE, s)."""
+    Brent's method around the best grid point.  With a ``hint`` (a shift found for a
+    neighbouring curve: the measured member's, for its prediction), Brent's method first
+    searches the two grid steps around it, and the grid runs only when the minimum lies
+    on that bracket's edge.  Returns (β, SSE, s)."""
     t_w = rt[start]
     span = rt[end - 1] - t_w
     lo = math.log(0.25 * dt)
     hi = math.log(t_w + 4.0 * span + dt)
     step_u = (hi - lo) / (N_SHIFTS - 1)
+    fixed = _shift_free_sums(rt, ry, start, end)
+    if hint + t_w > 0.0:
+        uh = min(max(math.log(hint + t_w), lo), hi)
+        ua = max(uh - step_u, lo)
+        ub = min(uh + step_u, hi)
+        bh, fh = _fit_with_log(rt, ry, start, end, math.exp(uh) - t_w, a, b, lg, fixed)
+        best, beta, u = _brent(rt, ry, start, end, t_w, ua, ub, uh, fh, bh, a, b, lg,
+                               fixed)  # fmt: skip
+        edge = 4.0 * BRENT_TOL * (ub - ua)
+        inside = (u - ua > edge or ua == lo) and (ub - u > edge or ub == hi)
+        if inside and best < math.inf:
+            return beta, best, math.exp(u) - t_w
     k_best = -1
     best, beta = math.inf, math.nan
     for k in range(N_SHIFTS):
         u = lo + k * step_u
-        bk, sse = _fit_with_log(rt, ry, start, end, math.exp(u) - t_w, a, b, lg)
+        bk, sse = _fit_with_log(rt, ry, start, end, math.exp(u) - t_w, a, b, lg, fixed)
         if sse < best:
             best, beta, k_best = sse, bk, k
     if k_best < 0:
@@ -445,7 +499,7 @@ def _fit_polynomial(rt, ry, start, end, dt, a, b, lg):
     ua = lo + max(k_best - 1, 0) * step_u
     ub = lo + min(k_best + 1, N_SHIFTS - 1) * step_u
     best, beta, u = _brent(rt, ry, start, end, t_w, ua, ub, lo + k_best * step_u, best, beta,
-                           a, b, lg)  # fmt: skip
+                           a, b, lg, fixed)  # fmt: skip
     return beta, best, math.exp(u) - t_w
 
 
@@ -530,9 +584,10 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out):
 
 
 @njit(cache=True)
-def refit(rt, ry, n, t_lo, t_hi, kind, dt, a, b, lg):
+def refit(rt, ry, n, t_lo, t_hi, kind, dt, a, b, lg, shift=math.nan):
     """β of the envelope points with times in ``[t_lo, t_hi]`` by the fit ``kind`` (the
-    measured member's window and kind, for its prediction)."""
+    measured member's window and kind, for its prediction; ``shift`` its shift, where
+    the search for the prediction's starts)."""
     start, end = n, 0
     for i in range(n):
         if rt[i] >= t_lo and start == n:
@@ -544,7 +599,7 @@ def refit(rt, ry, n, t_lo, t_hi, kind, dt, a, b, lg):
     if kind == K_EXPONENTIAL:
         return _fit_linear(rt, ry, start, end)[0]
     if kind == K_POLYNOMIAL:
-        return _fit_polynomial(rt, ry, start, end, dt, a, b, lg)[0]
+        return _fit_polynomial(rt, ry, start, end, dt, a, b, lg, shift)[0]
     if kind == K_OSCILLATING:
         return _fit_inverse(rt, ry, start, end)
     return math.nan
@@ -700,7 +755,8 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g
             lt[j, lev] = k * h
             lv[j, lev] = nrm
     n = records(lt, lv, j, rt, ry)
-    out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, out[C_KIND], h, a, b, lg)
+    out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, out[C_KIND], h, a, b, lg,
+                             out[C_SHIFT])  # fmt: skip
 
 
 # --------------------------------------------------------------------- one-step map
