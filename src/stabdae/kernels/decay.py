@@ -238,19 +238,18 @@ def records(lt, lv, j, rt, ry):
     envelope exactly when no higher level was visited later."""
     n = 0
     latest = -1.0
+    normal = True  # every norm positive, finite and normal
     for b in range(NBINS - 1, -1, -1):
         t = lt[j, b]
         if t > latest:
             latest = t
+            v = lv[j, b]
             rt[n] = t
-            ry[n] = lv[j, b]
+            ry[n] = v
+            normal &= (v >= _TINY) & (v < math.inf)
             n += 1
     # the logarithms in a loop of their own, which vectorizes (a row with a norm below
     # the normal floats, or a zero, takes the library's log)
-    normal = True
-    for i in range(n):
-        v = ry[i]
-        normal &= (v >= _TINY) & (v < math.inf)
     if normal:
         for i in range(n):
             ry[i] = log_normal(ry[i])
