@@ -40,8 +40,10 @@ ensemble of each scheme in this process (from the kernel cache when it is warm),
 integrator construction (LLVM) per tolerance, diffrax's first call per tolerance.
 
 Results: ``work_precision_ensemble.json`` (every run; per scene and error level 1e-6,
-1e-9, 1e-12 the cheapest configuration of each tool reaching it and the ratio
-stabdae / heyoka) and a figure ``work_precision_ensemble.png``.
+1e-9, 1e-12 the cheapest run of each tool reaching it and the ratio stabdae / heyoka, and
+beside them each tool's cost interpolated log–log along its ladders to the level itself,
+which shows how much of a ratio the ladders' spacing makes) and a figure
+``work_precision_ensemble.png``.
 
 Usage::
 
@@ -69,6 +71,9 @@ import sympy as sp
 import stabdae
 from stabdae.symbolic import load_spec
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from work_precision import cost_at  # noqa: E402  (a sibling study, not a package)
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 LEVELS = (1e-6, 1e-9, 1e-12)
@@ -86,19 +91,28 @@ class Scene:
     members: int | None = None  # fewer than --members where one run takes minutes
 
 
+# Where the cost is cheap to measure, the two ladders that decide the comparison (stabdae's
+# fixed-step DOP853, heyoka's tolerances) go in steps of about 1.25 and of one decade: the
+# cheapest run reaching an error level then overshoots it by at most a step of the ladder.
+DECADES = tuple(float(f"1e-{e}") for e in range(5, 16))
+
 SCENES = {
     "pendulum": Scene(
         "pendulum", 10.0, 10.0, (1e-6, 1e-2),
         fixed={"midpoint": (1000, 4000, 16000, 64000), "rk4": (500, 1000, 2000, 4000, 8000),
-               "dopri5": (250, 500, 1000, 2000, 4000), "dop853": (125, 250, 500, 1000, 2000)},
+               "dopri5": (250, 500, 1000, 2000, 4000),
+               "dop853": (64, 80, 100, 125, 160, 200, 250, 320, 400, 500, 640, 800, 1000,
+                          2000)},
         tols=(1e-5, 1e-7, 1e-9, 1e-11, 1e-13),
-        heyoka_tols=(1e-5, 1e-7, 1e-9, 1e-11, 1e-13, 1e-15)),
+        heyoka_tols=DECADES),
     "double_pendulum": Scene(
         "double_pendulum", 2.0, 10.0, (1e-6, 1e-2),
         fixed={"midpoint": (1000, 4000, 16000, 64000), "rk4": (250, 500, 1000, 2000, 4000),
-               "dopri5": (125, 250, 500, 1000, 2000), "dop853": (64, 125, 250, 500, 1000)},
+               "dopri5": (125, 250, 500, 1000, 2000),
+               "dop853": (32, 40, 50, 64, 80, 100, 125, 160, 200, 250, 320, 400, 500,
+                          1000)},
         tols=(1e-5, 1e-7, 1e-9, 1e-11, 1e-13),
-        heyoka_tols=(1e-5, 1e-7, 1e-9, 1e-11, 1e-13, 1e-15)),
+        heyoka_tols=DECADES),
     "andrews": Scene(
         "andrews", 0.03, 1e4, (1e-8, 1e-5),
         fixed={"midpoint": (2000, 8000), "rk4": (250, 500, 1000, 2000, 4000),
@@ -446,6 +460,20 @@ def cheapest(rows, level):
     return min(ok, key=lambda r: r["core_s_per_member"]) if ok else None
 
 
+def interpolated(rows, level):
+    """The cheapest cost at which a configuration reaches ``level`` when its ladder is read
+    log–log between the runs around the level (:func:`work_precision.cost_at`).  Not a
+    measurement: it shows how much of a ratio the ladders' spacing makes."""
+    best = None
+    for config in dict.fromkeys(r["config"] for r in rows):
+        sel = [r for r in rows if r["config"] == config]
+        cost, how = cost_at([r["error"] for r in sel], [r["core_s_per_member"] for r in sel],
+                            level)  # fmt: skip
+        if np.isfinite(cost) and (best is None or cost < best["core_s_per_member"]):
+            best = dict(config=config, core_s_per_member=cost, how=how)
+    return best
+
+
 def summarize(rows, agreement):
     out = {}
     for level in LEVELS:
@@ -455,9 +483,16 @@ def summarize(rows, agreement):
             if best is not None:
                 entry[tool] = {k: best[k] for k in ("config", "setting", "error",
                                                     "core_s_per_member")}  # fmt: skip
+            between = interpolated([r for r in rows if r["tool"] == tool], level)
+            if between is not None:
+                entry[f"{tool} interpolated"] = between
         if "stabdae" in entry and "heyoka" in entry:
             entry["stabdae_over_heyoka"] = (entry["stabdae"]["core_s_per_member"]
                                             / entry["heyoka"]["core_s_per_member"])  # fmt: skip
+        if "stabdae interpolated" in entry and "heyoka interpolated" in entry:
+            entry["stabdae_over_heyoka_interpolated"] = (
+                entry["stabdae interpolated"]["core_s_per_member"]
+                / entry["heyoka interpolated"]["core_s_per_member"])
         entry["resolved"] = level >= 10 * agreement
         out[f"{level:g}"] = entry
     return out
@@ -521,10 +556,13 @@ def main(argv=None):
                              rows=rows)  # fmt: skip
         for level, entry in results[name]["summary"].items():
             print(f"{name} error <= {level}: " + ", ".join(
-                f"{tool} {e['config']} {e['setting']:g} {e['core_s_per_member'] * 1e6:.2f} µs"
+                f"{tool} {e['config']} {e.get('setting', float('nan')):g} "
+                f"{e['core_s_per_member'] * 1e6:.2f} µs"
                 for tool, e in entry.items() if isinstance(e, dict))
                 + (f"; stabdae/heyoka {entry['stabdae_over_heyoka']:.2f}"
-                   if "stabdae_over_heyoka" in entry else ""))  # fmt: skip
+                   if "stabdae_over_heyoka" in entry else "")
+                + (f" (interpolated {entry['stabdae_over_heyoka_interpolated']:.2f})"
+                   if "stabdae_over_heyoka_interpolated" in entry else ""))  # fmt: skip
         args.out.mkdir(parents=True, exist_ok=True)  # after every scene: nothing lost
         (args.out / "work_precision_ensemble.json").write_text(
             json.dumps(dict(meta=meta, scenes=results), indent=1))

@@ -62,3 +62,45 @@ def test_work_precision_study_runs(tmp_path):
     assert saved["at_target"]["slider_crank"]["best_stabdae"] == s["best_stabdae"]
     assert (tmp_path / "work_precision_time.png").stat().st_size > 10_000
     assert (tmp_path / "work_precision_evals.png").stat().st_size > 10_000
+
+
+def test_ensemble_summary_picks_the_cheapest_run_and_reads_the_ladder_between_runs():
+    """The ensemble benchmark's summary: the cheapest measured run at or below each error
+    level per tool, their ratio, and each tool's cost read log–log along its ladder to the
+    level itself (exact for a power law)."""
+    bench = load_file(ROOT / "studies" / "bench_work_precision_ensemble.py",
+                      "stabdae_study_bench_wpe")  # fmt: skip
+
+    def ladder(tool, config, steps, c_err, c_cost, order):
+        # error c_err · N^-order and cost c_cost · N: a power law, exact under log–log
+        return [dict(tool=tool, config=config, setting=1.0 / n, error=c_err * n ** -order,
+                     core_s_per_member=c_cost * n) for n in steps]  # fmt: skip
+
+    rows = (ladder("stabdae", "dop853 fixed", (100, 200, 400), 5e3, 1e-8, 8)
+            + ladder("stabdae", "rk4 fixed", (100, 200, 400), 1.0, 2e-8, 4)
+            + ladder("heyoka", "batch, 1 thread", (50, 500), 1e2, 1e-7, 6))  # fmt: skip
+    out = bench.summarize(rows, agreement=1e-16)
+    level = bench.LEVELS[1]  # 1e-9
+    e = out[f"{level:g}"]
+    # measured: DOP853 is below 1e-9 from its first run (N = 100: 5e-13, cost 1e-6); RK4
+    # from N = 200 (6.25e-10), at a cost of 4e-6
+    assert e["stabdae"]["config"] == "dop853 fixed" and e["stabdae"]["setting"] == 1 / 100
+    assert math.isclose(e["stabdae"]["core_s_per_member"], 1e-6)
+    # heyoka reaches 1e-9 (1e2 · N⁻⁶ ≤ 1e-9 ⇔ N ≥ 10^(11/6) ≈ 68.1) at its N = 500 run
+    assert e["heyoka"]["setting"] == 1 / 500
+    assert math.isclose(e["stabdae_over_heyoka"], 1e-6 / 5e-5)
+    # interpolated: heyoka's power law read at the level, N = 10^(11/6) exactly
+    n_star = 10 ** (11 / 6)
+    assert math.isclose(e["heyoka interpolated"]["core_s_per_member"], 1e-7 * n_star,
+                        rel_tol=1e-12)  # fmt: skip
+    # stabdae's first run is already below: its interpolated cost is that run's
+    assert math.isclose(e["stabdae interpolated"]["core_s_per_member"], 1e-6)
+    assert math.isclose(e["stabdae_over_heyoka_interpolated"], 1e-6 / (1e-7 * n_star),
+                        rel_tol=1e-12)  # fmt: skip
+    assert e["stabdae interpolated"]["config"] == "dop853 fixed"
+    # RK4 read between its runs (N = 10^(9/4): 3.6e-6) is still dearer than DOP853's run;
+    # at 1e-12 only DOP853 (N = 100) and heyoka (N = 500: 6.4e-15) reach the level
+    e = out[f"{bench.LEVELS[2]:g}"]
+    assert e["stabdae interpolated"]["config"] == "dop853 fixed"
+    assert math.isclose(e["heyoka interpolated"]["core_s_per_member"], 1e-7 * 10 ** (14 / 6),
+                        rel_tol=1e-12)  # fmt: skip
