@@ -556,8 +556,8 @@ def main(argv=None):
                              rows=rows)  # fmt: skip
         for level, entry in results[name]["summary"].items():
             print(f"{name} error <= {level}: " + ", ".join(
-                f"{tool} {e['config']} {e.get('setting', float('nan')):g} "
-                f"{e['core_s_per_member'] * 1e6:.2f} µs"
+                f"{tool} {e['config']}" + (f" {e['setting']:g}" if "setting" in e else "")
+                + f" {e['core_s_per_member'] * 1e6:.2f} µs"
                 for tool, e in entry.items() if isinstance(e, dict))
                 + (f"; stabdae/heyoka {entry['stabdae_over_heyoka']:.2f}"
                    if "stabdae_over_heyoka" in entry else "")
