@@ -89,3 +89,62 @@ def test_pivot_rule_is_relative_to_the_matrix_scale(scale):
     np.testing.assert_allclose(L @ np.diag(1.0 / np.diag(buf)) @ L.T, good, rtol=1e-14)
     near = scale * np.array([[1.0, 1.0], [1.0, 1.0 + 1e-14]])
     assert ldl_inplace(near.copy(), 2, 1e-12) == 2
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 7, 8])
+def test_written_out_routines_give_the_loops_numbers_bit_for_bit(n):
+    """The straight-line factor and solves that a dense right-hand side uses for its sizes
+    (so that the ensemble kernel's member loop around them vectorizes) do the loops'
+    operations in the loops' order: the same bits, the same failing pivot, the same
+    untouched entries outside the leading block."""
+    from stabdae.kernels.linalg import (
+        UNROLL_MAX_OPS,
+        ldl_factor_for,
+        ldl_solve_columns_for,
+        ldl_solve_for,
+    )
+
+    assert ldl_factor_for(n) is not ldl_inplace  # written out at these sizes
+    rng = np.random.default_rng(10 + n)
+    B = rng.standard_normal((n, n))
+    A = B @ B.T + 0.1 * np.eye(n)
+    buf = np.full((n + 2, n + 2), 7.0)
+    buf[:n, :n] = A
+    buf[np.triu_indices(n, 1)] = 3.0  # the strict upper triangle is neither read nor written
+    loops, out = buf.copy(), buf.copy()
+    assert ldl_factor_for(n)(out, n, 1e-14) == ldl_inplace(loops, n, 1e-14) == 0
+    assert np.array_equal(out, loops)
+    b = rng.standard_normal(n)
+    x_loop, x_out = b.copy(), b.copy()
+    ldl_solve_inplace(loops, n, x_loop)
+    ldl_solve_for(n)(out, n, x_out)
+    assert np.array_equal(x_out, x_loop)
+    for ncols in (1, 3, 6):
+        Bm = rng.standard_normal((n + 1, ncols + 1))  # a larger buffer, leading block used
+        X_loop, X_out = Bm.copy(), Bm.copy()
+        ldl_solve_columns(loops, n, X_loop, ncols)
+        ldl_solve_columns_for(n, ncols)(out, n, X_out, ncols)
+        assert np.array_equal(X_out, X_loop)
+    # a pivot that fails reports the same (first) failing column
+    if n >= 2:
+        bad = buf.copy()
+        bad[n - 1, :n - 1] = bad[:n - 1, n - 1] = A[0, : n - 1]
+        bad[n - 1, n - 1] = A[0, 0]  # row n−1 repeats row 0: singular
+        bad_loop = bad.copy()
+        code = ldl_inplace(bad_loop, n, 1e-12)
+        assert code == n and ldl_factor_for(n)(bad, n, 1e-12) == code
+    # beyond the size limit the loops themselves (their code does not grow with n)
+    big = 1 + round((6 * UNROLL_MAX_OPS) ** (1 / 3))
+    assert ldl_factor_for(big) is ldl_inplace
+    assert ldl_solve_columns_for(n, UNROLL_MAX_OPS + 1) is ldl_solve_columns
+
+
+def test_written_out_routines_of_size_zero_do_nothing():
+    """A model without holonomic constraints (m = 0) gets the solves of size 0."""
+    from stabdae.kernels.linalg import ldl_solve_columns_for, ldl_solve_for
+
+    b = np.arange(3.0)
+    ldl_solve_for(0)(np.eye(3), 0, b)
+    ldl_solve_columns_for(0, 2)(np.eye(3), 0, np.eye(3), 2)
+    ldl_solve_columns_for(3, 0)(np.eye(3), 3, np.eye(3), 0)
+    assert np.array_equal(b, np.arange(3.0))

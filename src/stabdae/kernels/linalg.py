@@ -13,15 +13,29 @@ arithmetic as a hand-written ``λ = rhs / S``.  Loops have no early exits, so th
 vectorizes when inlined into the ensemble kernel's member loop.
 
 Only the leading ``n×n`` block of a buffer is touched, so one buffer can serve several sizes.
+
+For the small sizes of a dense model the right-hand side uses the same routines written
+out for its sizes (:func:`ldl_factor_for`, :func:`ldl_solve_for`,
+:func:`ldl_solve_columns_for`): straight-line code with the same operations in the same
+order, so the same numbers bit for bit.  LLVM vectorizes innermost loops only; a factor's
+loop over its columns, which it does not unroll when the body is large, left the ensemble
+kernel's member loop around it scalar.
 """
 
 from __future__ import annotations
 
 import math
+from functools import cache
 
 from numba import njit
 
 from .fma import fma
+from .source import exec_source
+
+#: the routines are written out when they take at most this many multiply-adds (a model of
+#: n = 7 coordinates and 6 constraints: 294 for ``M⁻¹ Fᵀ``); larger ones keep their loops,
+#: whose code does not grow with the size
+UNROLL_MAX_OPS = 512
 
 
 @njit(cache=True, error_model="numpy", forceinline=True)
@@ -250,3 +264,75 @@ def ldl_sparse_solve(l, n, b, lptr, lcol, ltptr, lrow):
             if p < n:  # (a leading block of the factor: rows below it left out)
                 s = fma(-l[p, i], b[p], s)
         b[i] = s
+
+
+# --------------------------------------------------------------------- written out
+def _factor_lines(n: int) -> list[str]:
+    """:func:`ldl_inplace`'s operations for size ``n``, in its order."""
+    out = ["dmax = abs(a[0, 0])"]
+    out += [f"dmax = max(dmax, abs(a[{i}, {i}]))" for i in range(1, n)]
+    out += ["tol = rtol * dmax", "fail = 0"]
+    for j in range(n):
+        for p in range(j):
+            out.append(f"s = a[{j}, {p}]")
+            out += [f"s = fma(-a[{j}, {q}], a[{p}, {q}], s)" for q in range(p)]
+            out.append(f"a[{j}, {p}] = s")
+        out.append(f"d = a[{j}, {j}]")
+        for p in range(j):
+            out += [f"w = a[{j}, {p}]", f"ljp = w * a[{p}, {p}]", "d = fma(-w, ljp, d)",
+                    f"a[{j}, {p}] = ljp"]  # fmt: skip
+        out += ["bad = not (d > tol)", f"fail += {j + 1} * (bad & (fail == 0))",
+                f"a[{j}, {j}] = 1.0 / d"]  # fmt: skip
+    return out + ["return fail"]
+
+
+def _solve_lines(n: int, at) -> list[str]:
+    """:func:`ldl_solve_inplace`'s operations for size ``n`` on the entries ``at(i)``."""
+    out = []
+    for i in range(n):  # L y = b
+        out.append(f"s = {at(i)}")
+        out += [f"s = fma(-l[{i}, {p}], {at(p)}, s)" for p in range(i)]
+        out.append(f"{at(i)} = s")
+    out += [f"{at(i)} *= l[{i}, {i}]" for i in range(n)]  # D z = y
+    for i in range(n - 1, -1, -1):  # Lᵀ x = z
+        out.append(f"s = {at(i)}")
+        out += [f"s = fma(-l[{p}, {i}], {at(p)}, s)" for p in range(i + 1, n)]
+        out.append(f"{at(i)} = s")
+    return out
+
+
+def _written_out(header: str, lines: list[str], label: str):
+    source = header + "\n" + "".join(f"    {line}\n" for line in lines or ["pass"])
+    fn = exec_source(source, label, {"fma": fma})[header[4:header.index("(")]]
+    return njit(error_model="numpy", forceinline=True)(fn)
+
+
+@cache
+def ldl_factor_for(n: int):
+    """:func:`ldl_inplace` for matrices of size ``n`` (its ``n`` argument is then ignored):
+    written out while it takes at most ``UNROLL_MAX_OPS`` multiply-adds, else itself."""
+    if n * n * n // 6 > UNROLL_MAX_OPS:
+        return ldl_inplace
+    return _written_out("def ldl_factor(a, n, rtol):", _factor_lines(n), f"ldl_factor_{n}")
+
+
+@cache
+def ldl_solve_for(n: int):
+    """:func:`ldl_solve_inplace` for size ``n``, written out as :func:`ldl_factor_for`."""
+    if n * n > UNROLL_MAX_OPS:
+        return ldl_solve_inplace
+    return _written_out("def ldl_solve(l, n, b):", _solve_lines(n, lambda i: f"b[{i}]"),
+                        f"ldl_solve_{n}")  # fmt: skip
+
+
+@cache
+def ldl_solve_columns_for(n: int, ncols: int):
+    """:func:`ldl_solve_columns` for size ``n`` and ``ncols`` columns, written out as
+    :func:`ldl_factor_for`."""
+    if n * n * ncols > UNROLL_MAX_OPS:
+        return ldl_solve_columns
+    lines = []
+    for c in range(ncols):
+        lines += _solve_lines(n, lambda i, c=c: f"b[{i}, {c}]")
+    return _written_out("def ldl_solve_columns(l, n, b, ncols):", lines,
+                        f"ldl_solve_columns_{n}x{ncols}")  # fmt: skip

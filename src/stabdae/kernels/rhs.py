@@ -42,8 +42,11 @@ from .cache import fingerprint, memo, optional_fingerprint, tag
 from .fma import fma
 from .jit import python_function
 from .linalg import (
+    ldl_factor_for,
     ldl_inplace,
     ldl_solve_columns,
+    ldl_solve_columns_for,
+    ldl_solve_for,
     ldl_solve_inplace,
     ldl_sparse_inplace,
     ldl_sparse_solve,
@@ -373,6 +376,11 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     LAW = law_code
     LSTSQ = lstsq
     law_A = _rejit(law_fn, _noop4)
+    # the dense path's factorizations written out for these sizes (same numbers as the
+    # loops; see :mod:`.linalg`)
+    factor_M, solve_M, solve_columns_M = (ldl_factor_for(n), ldl_solve_for(n),
+                                          ldl_solve_columns_for(n, r))  # fmt: skip
+    factor_S, solve_S, solve_Sm = ldl_factor_for(r), ldl_solve_for(r), ldl_solve_for(m)
 
     @njit(forceinline=True, error_model="numpy")
     def rhs(t, x, p, law_mat, law_scal, ws, xdot):
@@ -476,9 +484,9 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             _load_Ft(fq, hv, Y, m, r, n)
             if HAS_MASS:
                 mass(t, q, p, Mw)
-                bad_mass = ldl_inplace(Mw, n, MASS_RTOL) != 0
-                ldl_solve_columns(Mw, n, Y, r)
-                ldl_solve_inplace(Mw, n, z)
+                bad_mass = factor_M(Mw, n, MASS_RTOL) != 0
+                solve_columns_M(Mw, n, Y, r)
+                solve_M(Mw, n, z)
 
             # rl += F z, and S = F Y (symmetric; the lower triangle suffices for L D Lᵀ)
             for i in range(r):
@@ -491,8 +499,8 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
             if LSTSQ:  # redundant constraints: the minimum-norm least-squares λ
                 bad_S = pinv_solve_sym(S, r, rl, S_PINV_RTOL, ws.V, ws.ev, ws.mu) == 0
             else:
-                bad_S = ldl_inplace(S, r, S_RTOL) != 0
-                ldl_solve_inplace(S, r, rl)  # rl is now λ
+                bad_S = factor_S(S, r, S_RTOL) != 0
+                solve_S(S, r, rl)  # rl is now λ
 
             for j in range(n):
                 s = -z[j]
@@ -509,8 +517,8 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                 sm[i] = g[i]
             for i in range(k):
                 mu[m + i] = g[2 * m + i]
-            ldl_solve_inplace(S, r, mu)
-            ldl_solve_inplace(S, m, sm)
+            solve_S(S, r, mu)
+            solve_Sm(S, m, sm)
             gam = law_scal[0]
             for j in range(n):
                 dq = -0.0
