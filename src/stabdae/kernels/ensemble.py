@@ -79,7 +79,7 @@ BLOCK = 64
 #: the member step's sums over the state are written out per component while the state's
 #: size times the stages is at most this (a loop left in the step keeps the member loop
 #: around it from vectorizing; above it the code would grow with the model)
-UNROLL_MAX_TERMS = 256
+UNROLL_MAX_TERMS = 200
 #: the ensemble kernel checks the block at least this often (steps) and keeps a copy of it
 CHECKPOINT = 32
 _NONFINITE = int(Status.NONFINITE_STATE)
