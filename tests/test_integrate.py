@@ -177,7 +177,8 @@ def test_member_loop_of_a_dense_model_vectorizes(monkeypatch):
     (compiled here as the kernel compiles it: the member step of :mod:`.ensemble` with
     its inputs on the stack), vectorizes: its arithmetic is on vectors of doubles.  (The
     mass factor's loop over its columns stayed a loop, the member loop around it was not
-    innermost and ran scalar: a vector arithmetic instruction for every 30 scalar ones.)"""
+    innermost and ran scalar: 49 vector arithmetic instructions against 917 scalar ones;
+    written out, 1098 against 62.)"""
     from stabdae._schemes import as_scheme
     from stabdae.kernels.ensemble import BLOCK, _member_step, tableau_pattern
     from stabdae.kernels.workspace import copy_inputs, stack1, stack2
