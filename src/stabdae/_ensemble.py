@@ -52,8 +52,8 @@ REFERENCE_MAX_ENTRIES = 16_000_000
 #: the fixed-step kernel measures the residual at every ``s``-th step, ``s`` at most this
 #: many, over which no mode of the law changes by more than ``STRIDE_CHANGE`` in ``ln``
 #: (:func:`measure_stride`)
-MAX_STRIDE = 16
-STRIDE_CHANGE = 0.1
+MAX_STRIDE = 32
+STRIDE_CHANGE = 0.2
 
 #: why members stopped, as the summary warning names it
 _STOPPED = {

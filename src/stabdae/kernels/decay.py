@@ -574,9 +574,10 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out):
     if not (beta > 0.0):
         out[C_REASON] = R_NOT_DECAYING
         return
-    gamma = 0.0
+    top = -math.inf  # the exponential is monotone: one call, on the largest exponent
     for i in range(end):
-        gamma = max(gamma, math.exp(ry[i] + beta * rt[i]))
+        top = max(top, ry[i] + beta * rt[i])
+    gamma = math.exp(top)
     out[C_BETA] = beta
     out[C_GAMMA] = gamma
     out[C_REASON] = R_FITTED
@@ -658,10 +659,11 @@ def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
 
 
 @njit(cache=True)
-def finish_with_map(lt, lv, S, meas, j, row, final, stopped, ng, pm, base_j, dt, rt, ry, a,
-                    b, lg):  # fmt: skip
+def finish_with_map(lt, lv, S, meas, j, row, final, stopped, ng, pm, base_j, lowest, dt, rt,
+                    ry, a, b, lg):  # fmt: skip
     """:func:`finish` for a member with one-step map sums ``S`` (:func:`map_estimate`,
-    ``dt`` the time between the map's pairs): β from the map where it has one, else from
+    ``dt`` the time between the map's pairs; ``lowest`` a level below which ladder row
+    ``j`` has no point): β from the map where it has one, else from
     the envelope.  A member whose largest norms grow (:func:`grows`) gets the map only
     when the envelope does not find it growing (it may decay first, which the map would
     read), so its envelope is fitted first."""
@@ -672,8 +674,8 @@ def finish_with_map(lt, lv, S, meas, j, row, final, stopped, ng, pm, base_j, dt,
     if grows(out[C_D2], out[C_D3], out[C_D4]):
         fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
         if out[C_REASON] != R_NOT_DECAYING:
-            map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry)
-    elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry):
+            map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry, lowest)
+    elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry, lowest):
         fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
 
 
@@ -761,8 +763,16 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g
 # --------------------------------------------------------------------- one-step map
 @njit(cache=True)
 def map_buffers(rows, ng, pm):
-    """The one-step map's sums for ``rows`` members at a time: per member and bin the
-    sums of the pairs' outer products and their number (:func:`map_width` columns)."""
+    """The one-step map's sums for ``rows`` members at a time: per member and bin ``b``
+    the sums of the pairs' outer products and their number (:func:`map_width` columns)
+    over the pairs ``(g_k, g_{k+1})`` with ``g_k`` before the member's measured norm
+    first fell below bin ``b`` (below ladder level ``b · 2^MAP_SHIFT``): the pairs of the
+    transient above that level, none of the floor's once the floor lies below it.
+
+    (Binned by when rather than by each pair's level, so that a member adds to its bins
+    once per bin crossed: a residual on its floor moves between levels at random, and
+    a member that moved its sums at every change of bin did so at every few measured
+    states, about a fifth of the measurement's cost on the pendulum.)"""
     return np.zeros((rows, MAP_BINS, map_width(ng, pm)))
 
 
@@ -807,15 +817,18 @@ def block_measures(B: int, ng: int, pm: int):
 
     * the ladder: each member's level (``levels``, vectorized), then the time and norm
       written on it (``record``, a scatter);
-    * the one-step map: the pairs' sums of the current bin visit in ``A`` (a row per sum,
-      the symmetric ``Σ p pᵀ`` once), added to the member's bin when its level leaves
-      it (``bin_flush``: a scalar loop over the members whose bit is set in the mask
-      ``levels`` returns);
+    * the one-step map: the pairs' running sums in ``A`` (a row per sum, the symmetric
+      ``Σ p pᵀ`` once), copied to the member's row of ``S`` for each bin its level goes
+      below for the first time (``bin_flush``: a scalar loop over the members whose bit
+      is set in the mask ``levels`` returns; a member crosses each bin once, where a
+      flush at every change of bin came at every few measured states of a residual on
+      its floor), and at the end for the bins it never went below (``end_flush``);
     * the largest norms of the current fifth of the run in ``wmax`` and ``dmax``, written
       to the member's row when the fifth ends or the member stops (``windows_flush``).
 
-    The ladder is :func:`observe`'s; the map's sums are added per visit of a bin, then
-    into the bin.  Returns ``(norms, pairs_pooled, pairs_full, levels, record, bin_flush,
+    The ladder is :func:`observe`'s; bin ``b`` of the map's sums holds the pairs whose
+    first state came before the member's level first went below bin ``b``
+    (:func:`map_buffers`).  Returns ``(norms, pairs_pooled, pairs_full, levels, record, bin_flush,
     end_flush, windows_flush, rows_full)``, ``rows_full`` the rows of the full map's ``A`` (1 when
     ``ng > MAP_MAX_NG``: no full map)."""
     PM, NH = pm, ng - 2 * pm
@@ -889,12 +902,12 @@ def block_measures(B: int, ng: int, pm: int):
                 P[l, j] = Dv[l, j]
 
     @njit(forceinline=True, error_model="numpy")
-    def levels(gn, dn, base, lev, nlev, wmax, dmax):
+    def levels(gn, dn, base, low, nlev, wmax, dmax):
         """The block's norms ``gn`` (of ``g``) and ``dn`` (measured) at a state: the
         largest of the fifth, each slot's ladder level into ``nlev`` (``NBINS``, the
         ladder's spare column, for a non-finite norm, which :func:`observe` leaves out);
-        returns a mask of the slots whose level left the map's bin of ``lev``, the
-        previous state's levels."""
+        returns a mask of the slots whose level went below ``low``, the lowest of the
+        map's bins they had reached."""
         changed = 0
         for j in range(B):
             v = gn[j]
@@ -906,66 +919,67 @@ def block_measures(B: int, ng: int, pm: int):
             dmax[j] = d if (ok and not (dm >= d)) else dm
             b = ladder_level(d, base[j])
             nlev[j] = b if ok else NBINS
-            moved = ok and (b >> MAP_SHIFT) != (lev[j] >> MAP_SHIFT)
-            changed |= (1 if moved else 0) << j
+            lower = ok and (b >> MAP_SHIFT) < low[j]
+            changed |= (1 if lower else 0) << j
         return changed
 
     @njit(forceinline=True)
-    def record(lt, lv, dn, lev, nlev, t):
+    def record(lt, lv, dn, nlev, t):
         """Time ``t`` and norm on each slot's level (a scatter, apart from the vectorized
-        loops); then the levels are the previous state's."""
+        loops)."""
         for j in range(B):
             b = nlev[j]
             lt[j, b] = t
             lv[j, b] = dn[j]
-            if b < NBINS:
-                lev[j] = b
 
     @njit(forceinline=True)
-    def _move(S, A, j, bin_, pooled):
-        """Slot ``j``'s sums of the current bin visit into its bin ``bin_``."""
+    def _store(S, A, j, bin_, pooled):
+        """Slot ``j``'s sums so far as those of its bin ``bin_``."""
         if pooled >= 0:
-            S[j, bin_, 0] += A[0, j]
-            S[j, bin_, 1] += A[1, j]
-            S[j, bin_, 2] += A[1, j]
-            S[j, bin_, 3] += A[2, j]
+            S[j, bin_, 0] = A[0, j]
+            S[j, bin_, 1] = A[1, j]
+            S[j, bin_, 2] = A[1, j]
+            S[j, bin_, 3] = A[2, j]
             for c in range(4):
-                S[j, bin_, 4 + c] += A[3 + c, j]
-            S[j, bin_, 8] += A[7, j]
-            S[j, bin_, 9] += A[8, j]
-            S[j, bin_, 10] += A[9, j]
-            for c in range(10):
-                A[c, j] = 0.0
+                S[j, bin_, 4 + c] = A[3 + c, j]
+            S[j, bin_, 8] = A[7, j]
+            S[j, bin_, 9] = A[8, j]
+            S[j, bin_, 10] = A[9, j]
         elif FULL:
             c = 0
             for r in range(FULL):
                 for q in range(r, FULL):
-                    S[j, bin_, r * FULL + q] += A[c, j]
+                    S[j, bin_, r * FULL + q] = A[c, j]
                     if q != r:
-                        S[j, bin_, q * FULL + r] += A[c, j]
+                        S[j, bin_, q * FULL + r] = A[c, j]
                     c += 1
             for r in range(FULL * FULL):
-                S[j, bin_, FULL * FULL + r] += A[c, j]
+                S[j, bin_, FULL * FULL + r] = A[c, j]
                 c += 1
-            S[j, bin_, 2 * FULL * FULL] += A[c, j]
-            for c in range(ROWS_FULL):
-                A[c, j] = 0.0
+            S[j, bin_, 2 * FULL * FULL] = A[c, j]
 
     @njit(error_model="numpy")
-    def bin_flush(S, A, lev, mask, pooled):
-        """The slots of the set bits of ``mask``, whose level left the map's bin of the
-        previous state: that visit's sums into that bin."""
+    def bin_flush(S, A, nlev, low, mask, pooled):
+        """The slots of the set bits of ``mask``, whose level went below the lowest bin
+        they had reached: their sums so far (the pair just added, from a state above,
+        included) become those of each bin passed, down to the new one's, which is then
+        the lowest."""
         while mask != 0:
             j = trailing_zeros(mask)
             mask &= mask - 1
-            _move(S, A, j, lev[j] >> MAP_SHIFT, pooled)
+            nb = nlev[j] >> MAP_SHIFT
+            for b in range(nb + 1, low[j] + 1):
+                _store(S, A, j, b, pooled)
+            low[j] = nb
 
     @njit(error_model="numpy")
-    def end_flush(S, A, lev, active, pooled):
-        """At the end of the run: each running slot's current bin visit's sums."""
+    def end_flush(S, A, low, active, pooled):
+        """At the end of the run: each running slot's sums as those of the bins it did not
+        go below."""
         for j in range(B):
             if active[j]:
-                _move(S, A, j, lev[j] >> MAP_SHIFT, pooled)
+                for b in range(low[j] + 1):
+                    _store(S, A, j, b, pooled)
 
     @njit(error_model="numpy")
     def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
@@ -1055,14 +1069,12 @@ def spectral_radius_of(R):
 @njit(cache=True)
 def _pooled_radius(S, j, first):
     """``ρ`` of the pooled fits (:func:`map_buffers`): the larger of the 2 × 2 map of
-    the ``(f_i, ḟ_i)`` pairs and the 1 × 1 map of the ``h_j``, each where it has data;
-    the number of pairs."""
+    the ``(f_i, ḟ_i)`` pairs and the 1 × 1 map of the ``h_j``, each where it has data,
+    from the pairs of bin ``first`` (those before the level first fell below it); the
+    number of pairs."""
     s = stack1(11)
     for c in range(11):
-        s[c] = 0.0
-    for b in range(first, S.shape[1]):
-        for c in range(11):
-            s[c] += S[j, b, c]
+        s[c] = S[j, first, c] if first < S.shape[1] else 0.0
     rho = -1.0
     det = s[0] * s[3] - s[1] * s[2]
     if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:  # S1 S0⁻¹
@@ -1075,23 +1087,23 @@ def _pooled_radius(S, j, first):
 
 @njit(cache=True)
 def _map_radius(S, j, ng, first):
-    """``ρ`` of the least-squares one-step map ``R̂ = S1 S0⁻¹`` from the bins of slot
-    ``j`` from ``first`` up, on the directions its pairs span, and the number of pairs;
-    NaN with fewer than ``2 ng`` pairs."""
+    """``ρ`` of the least-squares one-step map ``R̂ = S1 S0⁻¹`` from bin ``first`` of
+    slot ``j`` (the pairs before its level first fell below that bin), on the directions
+    its pairs span, and the number of pairs; NaN with fewer than ``2 ng`` pairs."""
     S0 = np.zeros((ng, ng))
     S1 = np.zeros((ng, ng))
     pairs = 0.0
-    for b in range(first, S.shape[1]):
+    if first < S.shape[1]:
         c = 0
         for r in range(ng):
             for q in range(ng):
-                S0[r, q] += S[j, b, c]
+                S0[r, q] = S[j, first, c]
                 c += 1
         for r in range(ng):
             for q in range(ng):
-                S1[r, q] += S[j, b, c]
+                S1[r, q] = S[j, first, c]
                 c += 1
-        pairs += S[j, b, c]
+        pairs = S[j, first, c]
     if pairs < 2.0 * ng:
         return math.nan, pairs
     # Whitened (each component scaled to unit sum of squares) and restricted to the
@@ -1123,20 +1135,49 @@ def _map_radius(S, j, ng, first):
     return spectral_radius_of(Rr), pairs
 
 
+@njit(cache=True, error_model="numpy")
+def _map_gamma(lt, lv, j, lo, top, beta, u):
+    """``γ = max ‖g(t)‖ e^{βt}`` over the envelope's points on levels ``lo … top`` of
+    ladder row ``j``, and the latest time on them (``u``: scratch of ``NBINS``).
+
+    Taken over every visited level, not only the envelope's: a level's last visit that
+    is not on the envelope has a higher level visited later, whose larger norm at a later
+    time gives a larger product (β > 0), so the maximum is the same.  Without the
+    envelope's running comparison, and with ``ln ‖g‖ + βt`` computed in a loop of its own
+    (branch-free: it vectorizes) and the exponential taken once, of the largest (it is
+    monotone), this costs a fraction of the envelope's loop with an exponential per
+    point, which was most of the cost of a member's end.  (A zero or subnormal norm,
+    where :func:`log_normal` does not hold, stands in for no point: its product is below
+    any other's.)"""
+    for b in range(lo, top + 1):
+        t = lt[j, b]
+        v = lv[j, b]
+        ok = (t >= 0.0) & (v >= _TINY) & (v < math.inf)
+        u[b] = (log_normal(v if ok else 1.0) + beta * t) if ok else -math.inf
+    best = -math.inf
+    t_end = -1.0
+    for b in range(lo, top + 1):
+        best = max(best, u[b])
+        t_end = max(t_end, lt[j, b])
+    return (math.exp(best) if best > -math.inf else 0.0), t_end
+
+
 @njit(cache=True)
-def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry):
+def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry, lowest=0):
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
-    still decaying (``MAP_STILL_DECAYING``), else those from its start down to
-    ``MAP_MARGIN`` (then ``FLOOR_MARGIN``) times its floor, give ``R̂`` by least
-    squares; ``β = −ln ρ(R̂)/τ``.  For a residual that
-    follows ``g_{k+1} = R g_k`` this is ``−ln ρ(R)/τ`` exactly, whatever the window, the
-    modes' mix or a repeated eigenvalue's polynomial prefactor, where a fit of the norm's
-    envelope over a short transient is biased.  The pairs must span a decade
-    (``MIN_DECADES``) above the cut; a member without such pairs, or whose map is
-    singular or has ``ρ ≥ 1``, is left to the envelope's fit (:func:`fit_envelope`).
-    Returns whether it gave β."""
+    still decaying (``MAP_STILL_DECAYING``), else those from its start until its level
+    first fell below ``MAP_MARGIN`` (then ``FLOOR_MARGIN``) times its floor (rounded up
+    to a bin of :func:`map_buffers`), give ``R̂`` by least squares; ``β = −ln ρ(R̂)/τ``.
+    For a residual that follows ``g_{k+1} = R g_k`` this is ``−ln ρ(R)/τ`` exactly,
+    whatever the window, the modes' mix or a repeated eigenvalue's polynomial prefactor,
+    where a fit of the norm's envelope over a short transient is biased.  The pairs must
+    span a decade (``MIN_DECADES``) above the cut; a member without such pairs, or whose
+    map is singular or has ``ρ ≥ 1``, is left to the envelope's fit
+    (:func:`fit_envelope`).
+    ``lowest``: no level below it was visited (γ's pass starts there).  Returns whether
+    it gave β."""
     out = meas[row]
     if S.shape[2] == 0:
         return False
@@ -1165,14 +1206,7 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry):
         if not (rho < 1.0 and rho > 0.0):
             return False
         beta = -math.log(rho) / tau
-        # γ over the envelope's points above the cut (:func:`records`, without its logs)
-        gamma = 0.0
-        t_end = -1.0
-        for b in range(top, (first << MAP_SHIFT) - 1, -1):
-            t = lt[j, b]
-            if t > t_end:
-                t_end = t
-                gamma = max(gamma, lv[j, b] * math.exp(beta * t))
+        gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta, ry)
         out[C_BETA] = beta
         out[C_GAMMA] = gamma
         out[C_FIT_START] = 0.0

@@ -57,6 +57,7 @@ from numba import njit
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
 from .decay import (
+    MAP_SHIFT,
     begin,
     block_measures,
     finish_with_map,
@@ -360,14 +361,15 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         # The measurement (:func:`.decay.block_measures`): the one-step map's sums per
         # slot and bin, fed from the measured states' g − g_ref (Dv: each step's g, made
         # g − g_ref, with the norms gs, ds, at a measured one) through the previous one
-        # (P) and the current bin visit's sums (Am); each slot's ladder offset, its level
-        # at the previous measured state and at this one; the largest norms of the fifth.
+        # (P) and the running sums (Am); each slot's ladder offset, the lowest of the
+        # map's bins it reached and its level at this state; the largest norms of the
+        # fifth.
         S_map = map_buffers(B, ng, pooled)
         Dv = stack2(ng, B)
         P = stack2(ng, B)
         Am = stack2(NA, B)
         base_s = stack_int1(B)
-        lev = stack_int1(B)
+        low = stack_int1(B)
         nlev = stack_int1(B)
         wmax = stack1(B)
         dmax = stack1(B)
@@ -397,7 +399,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             block_norms(X, t0, p_s, gr, nrm_b, dn_b)
             for j in range(B):
                 base_s[j] = ladder_base(dn_b[j])
-                lev[j] = ladder_level(dn_b[j], base_s[j])
+                low[j] = ladder_level(dn_b[j], base_s[j]) >> MAP_SHIFT
                 wmax[j] = -math.inf
                 dmax[j] = -math.inf
                 for l in range(ng):
@@ -466,10 +468,10 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                         pairs_pooled(Dv, P, Am, weight)
                     elif ROWS_FULL > 1:
                         pairs_full(Dv, P, Am, weight)
-                    changed = levels(gs, ds, base_s, lev, nlev, wmax, dmax)
+                    changed = levels(gs, ds, base_s, low, nlev, wmax, dmax)
                     if changed != 0:
-                        bin_flush(S_map, Am, lev, changed, pooled)
-                    record(lt, lv, ds, lev, nlev, k * tau)
+                        bin_flush(S_map, Am, nlev, low, changed, pooled)
+                    record(lt, lv, ds, nlev, k * tau)
                     k_last = k
                 measured = max(measured, i)
                 until_save -= 1
@@ -520,8 +522,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     gr[l] = g_ref[nsteps, l]
             block_norms(X, tf, p_s, gr, nrm_b, dn_b)
             windows_flush(meas, wmax, dmax, window, active, lo, cnt)
-            if k_last >= 0:  # the last bin visit's sums
-                end_flush(S_map, Am, lev, active, pooled)
+            if k_last >= 0:  # the sums of the bins not gone below
+                end_flush(S_map, Am, low, active, pooled)
             for j in range(cnt):
                 final = math.nan
                 if active[j]:
@@ -532,8 +534,11 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 for l in range(N2):
                     xs_h[l] = x_final[lo + j, l]
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
+                # no level below the lowest bin measured or the final state's was visited
+                lowest = min(low[j] << MAP_SHIFT, ladder_level(dn_b[j], base[j]))
                 finish_with_map(lt, lv, S_map, meas, j, lo + j, final, not active[j], ng,
-                                pooled, base[j], stride * tau, rt, ry, fa, fb, lg)  # fmt: skip
+                                pooled, base[j], lowest, stride * tau, rt, ry, fa, fb,
+                                lg)  # fmt: skip
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
                             meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
