@@ -1014,6 +1014,20 @@ def test_measurement_stride_changes_no_rate(monkeypatch):
         assert (strided[name].values <= every[name].values).all(), name
 
 
+def test_map_window_of_a_member_still_decaying_ends_at_the_run_end():
+    """A member whose residual still falls when the run ends (ω = 10 over 2 s: no floor
+    yet) has the whole run as its map's window: ``fit_end`` is the final time, whose
+    state is on the ladder though the stride does not measure it (s = 20 ends at step
+    1980), and γ covers it."""
+    model = load_scene("pendulum")
+    ds = stabdae.ensemble(model, stabdae.baumgarte(10, 1), "midpoint", 1e-3, 2.0,
+                          members=256, radius=(1e-6, 1e-2), seed=5, traces="none")  # fmt: skip
+    still = ds.floor_reached.values == 0
+    assert ds.attrs["measure_every"] == 20 and still.sum() > 200
+    assert set(ds.fit_kind.values[still].tolist()) == {decay.K_MAP}
+    np.testing.assert_array_equal(ds.fit_end.values[still], 2.0)
+
+
 def test_members_whose_floor_rises_keep_the_map_rate():
     """Under-damped double pendulum (ω = 20, ξ = 0.75, midpoint, τ = 2/700, 4 s, radii
     1e-7 … 1e-3, as a point of the shipped τ × ξ study): most members start near the floor,

@@ -438,11 +438,11 @@ def measure_stride(R) -> int:
     ``R = R(τÃ)`` changes by at most ``STRIDE_CHANGE`` (``|ln λ|`` for each eigenvalue
     λ: decay and rotation together); 1 for a law that is not constant (no ``R``).
 
-    The measurement's cost is memory traffic beside a step that may cost as little (a
-    pendulum's step is a few nanoseconds); over such a stride a mode moves by a few
-    per cent, so the envelope, the peak (off by at most about ``STRIDE_CHANGE²/8``) and
-    the floor are read as from every step, and the one-step map fitted to pairs a
-    stride apart is ``R^s``, whose spectral radius is ``ρ(R)^s`` exactly."""
+    The measurement's cost is memory traffic beside a step that may cost less (a
+    pendulum's step is a few nanoseconds); over such a stride a mode moves by at most a
+    fifth, so the envelope, the peak (read low by at most about ``STRIDE_CHANGE²/8``, half
+    a per cent) and the floor are read as from every step, and the one-step map fitted to
+    pairs a stride apart is ``R^s``, whose spectral radius is ``ρ(R)^s`` exactly."""
     if R.size == 0:
         return 1
     lam = np.linalg.eigvals(np.asarray(R, dtype=float)).astype(complex)
