@@ -1147,8 +1147,9 @@ def _map_gamma(lt, lv, j, lo, top, beta, u):
     (branch-free: it vectorizes) and the exponential taken once, of the largest (it is
     monotone), this costs a fraction of the envelope's loop with an exponential per
     point, which was most of the cost of a member's end.  (A zero or subnormal norm,
-    where :func:`log_normal` does not hold, stands in for no point: its product is below
-    any other's.)"""
+    where :func:`log_normal` does not hold, is left out: a zero's product is zero, and a
+    subnormal one, below 1e-308, lies on the ladder's bottom level, far under any
+    transient.)"""
     for b in range(lo, top + 1):
         t = lt[j, b]
         v = lv[j, b]
