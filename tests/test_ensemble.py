@@ -555,7 +555,8 @@ def test_map_gamma_is_the_largest_product_on_the_envelope():
     branch-free pass, is ``max ‖g‖e^{βt}`` over the right envelope's points on the levels
     from the cut up (:func:`decay.records`, the definition), and the latest time is that
     of the envelope: on a noisy decay with rises (points that are not on the envelope) and
-    a zero norm (none), at rates below, at and above the decay's."""
+    a zero norm (none), at rates below, at and above the decay's; from a cut below the
+    ladder (none of it left out), and over fewer levels than the pass takes at a time."""
     import struct
 
     rng = np.random.default_rng(11)
@@ -571,7 +572,7 @@ def test_map_gamma_is_the_largest_product_on_the_envelope():
         lt[0, level[i]], lv[0, level[i]] = t[i], x
     top = max(level)
     u = np.empty(decay.NBINS)
-    for lo in (0, min(level) + 40, top - 60):
+    for lo in (-3, 0, min(level) + 40, top - 60, top - 5, top):  # runs of 8 levels, a tail
         above = {lev: i for i, lev in enumerate(level) if lev >= lo}  # last visit per level
         later_max = np.maximum.accumulate(v[::-1])[::-1]  # the largest from each sample on
         env = [i for i in above.values()
