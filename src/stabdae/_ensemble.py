@@ -28,7 +28,7 @@ from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_
 from ._status import Status
 from .kernels import decay
 from .kernels.adaptive import LANES, adaptive_block_for
-from .kernels.ensemble import BLOCK, ensemble_kernel_for
+from .kernels.ensemble import BLOCK, ensemble_kernel_for, reference_kernel_for
 from .kernels.sampler import (
     CHUNK,
     SAMPLING_RTOL,
@@ -36,7 +36,6 @@ from .kernels.sampler import (
     residual_rows_for,
     sampler_for,
 )
-from .kernels.steps import residual_trajectory_for
 from .kernels.threads import default_threads, run_chunks
 
 __all__ = ["ensemble", "sample_perturbations"]
@@ -293,7 +292,7 @@ def ensemble(
                               np.random.default_rng(seed))  # fmt: skip
         x0, alpha0, status = _place(model, targets, p, t0, threads)
         if not adaptive:
-            g_ref = _reference_residuals(model, bound, scheme, p, t0, tau, nsteps)
+            g_ref = _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block)
     else:
         alpha0 = _residual_rows(model, x0, p, t0, threads)
         status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
@@ -340,17 +339,19 @@ def ensemble(
     return ds
 
 
-def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps):
+def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK):
     """The residual ``g`` at every step of the trajectory from the model's reference state
     (``α⁰ = 0``): the truncation error's forced response, the same for every member of a
     sampled ensemble up to ``O(‖α⁰‖)``.  Each member's decay is measured on its distance
     from it, so that the rate is read far below the floor the raw residual settles on.
     None (an empty array: the raw residual is measured) when it would take more than
-    ``REFERENCE_MAX_ENTRIES`` numbers or does not run to the end."""
+    ``REFERENCE_MAX_ENTRIES`` numbers or does not run to the end.  (Stepped by the
+    ensemble kernel's own member step, which the kernel of ``block`` members then reuses
+    compiled: a stepper of its own was another quarter of a new model's first compile.)"""
     ng = model.n_residual
     if (nsteps + 1) * ng > REFERENCE_MAX_ENTRIES:
         return np.zeros((0, ng))
-    kernel = residual_trajectory_for(model, bound)
+    kernel = reference_kernel_for(model, bound, scheme, block)
     out_g = np.full((nsteps + 1, ng), np.nan)
     status, _ = kernel(model.reference_state(p), t0, tau, nsteps, p, bound.matrix,
                        bound.scalars, scheme.A, scheme.b, scheme.c, out_g)  # fmt: skip

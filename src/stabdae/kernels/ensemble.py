@@ -201,6 +201,18 @@ def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the kinds of
     the scheme's coefficients, block, the shape of the law's matrix and whether the decay
     measurement pools the constraints, :func:`pooled_constraints`)."""
+    return _kernels(model, bound, scheme, block)[0]
+
+
+def reference_kernel_for(model, bound, scheme, block: int = BLOCK):
+    """``kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c, out_g)``:
+    the residual at every step of one trajectory, ``(status, steps completed)``, by the
+    step of :func:`ensemble_kernel_for`'s kernel (the ensemble's reference trajectory;
+    the step compiles once for both)."""
+    return _kernels(model, bound, scheme, block)[1]
+
+
+def _kernels(model, bound, scheme, block):
     pattern = tableau_pattern(scheme)
     shape = bound.matrix.shape
     n_params = len(model.param_names)
@@ -217,7 +229,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     ``block`` members, ``n_params`` parameters, a law matrix of shape ``law_shape`` and
     the decay measurement's one-step map pooled over ``pooled`` holonomic constraints
     (−1: the full map; :func:`.decay.map_width`), all fixed at compile time; the
-    scheme's coefficients, the parameters and the law's numbers are run-time arrays."""
+    scheme's coefficients, the parameters and the law's numbers are run-time arrays.
+    Returns it and the reference trajectory's kernel (:func:`reference_kernel_for`)."""
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
     N2, ng = 2 * K.n, K.ng
@@ -305,6 +318,52 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                 bad |= not math.isfinite(X[l, j])
         return bad
 
+    @njit(forceinline=True)
+    def copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc):
+        for i in range(S_):
+            tb[i] = tab_b[i]
+            tc[i] = tab_c[i]
+            for j in range(S_):
+                ta[i, j] = tab_a[i, j]
+
+    @njit(error_model="numpy")
+    def reference_kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c,
+                         out_g):  # fmt: skip
+        """``g`` at every step of the trajectory from ``x0`` into the rows of ``out_g``
+        (rows after a failure are left untouched); ``(status, steps completed)``.  The
+        members' own step (``member_step``, one member), so that it is compiled once for
+        both kernels and gives the numbers a member from ``x0`` would."""
+        p_s = stack1(NP)
+        lm = stack2(LR, LC)
+        ls = stack1(1)
+        copy_inputs(p, law_mat, law_scal, p_s, lm, ls)
+        ta = stack2(S_, S_)
+        tb = stack1(S_)
+        tc = stack1(S_)
+        copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc)
+        ws = stack_workspace()
+        xk = stack1(N2)
+        xs = stack1(N2)
+        xn = stack1(N2)
+        gv = stack1(ng)
+        for l in range(N2):
+            xk[l] = x0[l]
+        for i in range(1, nsteps + 1):
+            c = member_step(t0 + (i - 1) * tau, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn,
+                            gv)  # fmt: skip
+            for l in range(ng):  # g(x_{i-1}), evaluated by the step's first stage
+                out_g[i - 1, l] = gv[l]
+            if c != 0:
+                return c, i - 1
+            for l in range(N2):
+                if not math.isfinite(xn[l]):
+                    return _NONFINITE, i - 1
+                xk[l] = xn[l]
+        residual(t0 + nsteps * tau, xk, p_s, ws, gv)
+        for l in range(ng):
+            out_g[nsteps, l] = gv[l]
+        return 0, nsteps
+
     @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
                    tab_b, tab_c, threshold, g_ref, R, stride, trace_row, out_norm, meas,
@@ -333,11 +392,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         ta = stack2(S_, S_)
         tb = stack1(S_)
         tc = stack1(S_)
-        for i in range(S_):
-            tb[i] = tab_b[i]
-            tc[i] = tab_c[i]
-            for j in range(S_):
-                ta[i, j] = tab_a[i, j]
+        copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc)
         # The block, updated in place (member j's step reads and writes column j only, so
         # the loop needs no run-time alias checks); its copy at the last check that it
         # passed (at most CHECKPOINT steps old), to roll back to; the status of each
@@ -544,6 +599,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                             meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape, pooled)
-    tag(key, block_norms, retire, stop_failed, block_failed, member_step, norms, pairs_pooled,
-        pairs_full, levels, record, bin_flush, end_flush, windows_flush)
-    return keyed_cache(soa_kernel, key)
+    tag(key, block_norms, retire, stop_failed, block_failed, member_step, copy_tableau, norms,
+        pairs_pooled, pairs_full, levels, record, bin_flush, end_flush, windows_flush)
+    return keyed_cache(soa_kernel, key), keyed_cache(reference_kernel,
+                                                     kernel_key(key, "reference"))

@@ -2,8 +2,8 @@
 
 ``step`` applies one step of a tableau ``(A, b, c)`` given as run-time arrays (a new
 scheme never recompiles); ``integrate_kernel`` runs it over a trajectory, storing state,
-residual and energy every ``save_every`` steps, and projecting after each step when asked;
-``residual_kernel`` runs it storing only the residual, at every step.  The multiply-adds
+residual and energy every ``save_every`` steps, and projecting after each step when asked.
+The multiply-adds
 are fused (:mod:`.fma`) at the same places as in the ensemble kernel's generated step
 (:mod:`.ensemble`), so that both give the same bits.
 """
@@ -21,13 +21,12 @@ from .cache import kernel_key, keyed_cache, memo
 from .fma import fma
 from .rhs import kernels_for
 
-__all__ = ["Stepper", "integrator_for", "multipliers_for", "residual_trajectory_for",
-           "sample_writer", "stepper_for"]
+__all__ = ["Stepper", "integrator_for", "multipliers_for", "sample_writer", "stepper_for"]
 
 _NONFINITE = int(Status.NONFINITE_STATE)
 
 
-Stepper = namedtuple("Stepper", "step integrate residuals")
+Stepper = namedtuple("Stepper", "step integrate")
 
 
 def stepper_for(model, bound, multiplier: str = "ldl") -> Stepper:
@@ -40,15 +39,6 @@ def stepper_for(model, bound, multiplier: str = "ldl") -> Stepper:
 def integrator_for(model, bound, multiplier: str = "ldl"):
     """The compiled single-trajectory loop for ``model`` under the law's kind."""
     return stepper_for(model, bound, multiplier).integrate
-
-
-def residual_trajectory_for(model, bound):
-    """``kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c, out_g)``:
-    the residual at every step of one trajectory, ``(status, steps completed)``.  The
-    numbers :func:`integrator_for`'s loop gives without projection, saving every step,
-    from a kernel of the step and the residual only (that loop also compiles the
-    projection and the energy): the ensemble's reference trajectory."""
-    return stepper_for(model, bound).residuals
 
 
 def sample_writer(K):
@@ -70,7 +60,7 @@ def sample_writer(K):
 
 
 def _build_stepper(K):
-    rhs, make_workspace, project, residual = K.rhs, K.make_workspace, K.project, K.residual
+    rhs, make_workspace, project = K.rhs, K.make_workspace, K.project
     save = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
 
@@ -136,28 +126,9 @@ def _build_stepper(K):
                 j += 1
         return 0, nsteps
 
-    @njit(error_model="numpy")
-    def residual_kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c,
-                        out_g):  # fmt: skip
-        """``g`` at every step from ``x0`` into the rows of ``out_g`` (rows after a failure
-        are left untouched); ``(status, steps completed)``."""
-        ws = make_workspace()
-        stages = np.empty((tab_b.shape[0], N2))
-        xs = np.empty(N2)
-        x = x0.copy()
-        residual(t0, x, p, ws, out_g[0])
-        for i in range(1, nsteps + 1):
-            st = step(x, t0 + (i - 1) * tau, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c,
-                      ws, stages, xs)  # fmt: skip
-            if st != 0:
-                return st, i - 1
-            residual(t0 + i * tau, x, p, ws, out_g[i])
-        return 0, nsteps
-
     keyed_cache(step, kernel_key(K.key, "step"))
     keyed_cache(integrate_kernel, kernel_key(K.key, "integrate"))
-    keyed_cache(residual_kernel, kernel_key(K.key, "residuals"))
-    return Stepper(step, integrate_kernel, residual_kernel)
+    return Stepper(step, integrate_kernel)
 
 
 def multipliers_for(model, bound, multiplier: str = "ldl"):
