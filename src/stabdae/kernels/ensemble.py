@@ -333,6 +333,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         (rows after a failure are left untouched); ``(status, steps completed)``.  The
         members' own step (``member_step``, one member), so that it is compiled once for
         both kernels and gives the numbers a member from ``x0`` would."""
+        # the step's inputs on the stack, as in the ensemble kernel (a stack buffer lives
+        # in the frame that allocates it, so these lines cannot move into a helper)
         p_s = stack1(NP)
         lm = stack2(LR, LC)
         ls = stack1(1)
