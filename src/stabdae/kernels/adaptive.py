@@ -377,7 +377,7 @@ def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple) -> str:
 def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B: int,
                           n_params: int, law_shape):  # fmt: skip
     from .source import exec_source
-    from .workspace import copy_inputs, stack1, stack2, stack_int1
+    from .workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 
     rhs, residual, energy = K.rhs, K.residual, K.energy
     make_workspace, stack_workspace = K.make_workspace, K.stack_workspace
@@ -418,11 +418,7 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
         tb = stack1(s)
         tc = stack1(s)
         te = stack2(2, s_e)
-        for i in range(s):
-            tb[i] = tab_b[i]
-            tc[i] = tab_c[i]
-            for j in range(s):
-                ta[i, j] = tab_a[i, j]
+        copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc)
         for i in range(2):
             for j in range(s_e):
                 te[i, j] = tab_e[i, j]

@@ -926,10 +926,9 @@ def block_measures(B: int, ng: int, pm: int):
     @njit(forceinline=True)
     def record(lt, lv, dn, nlev, t):
         """Time ``t`` and norm on each slot's level (a scatter, apart from the vectorized
-        loops; the level unsigned, which numba does not wrap around as it would a
-        possibly negative index)."""
+        loops)."""
         for j in range(B):
-            b = np.uint64(nlev[j])
+            b = nlev[j]
             lt[j, b] = t
             lv[j, b] = dn[j]
 

@@ -74,7 +74,7 @@ from .decay import (
 from .fma import fma
 from .rhs import kernels_for
 from .source import exec_source
-from .workspace import copy_inputs, stack1, stack2, stack_int1
+from .workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 
 BLOCK = 64
 #: the member step's sums over the state are written out per component while the state's
@@ -317,14 +317,6 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             for l in range(N2):
                 bad |= not math.isfinite(X[l, j])
         return bad
-
-    @njit(forceinline=True)
-    def copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc):
-        for i in range(S_):
-            tb[i] = tab_b[i]
-            tc[i] = tab_c[i]
-            for j in range(S_):
-                ta[i, j] = tab_a[i, j]
 
     @njit(error_model="numpy")
     def reference_kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c,
@@ -601,7 +593,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                             meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape, pooled)
-    tag(key, block_norms, retire, stop_failed, block_failed, member_step, copy_tableau, norms,
+    tag(key, block_norms, retire, stop_failed, block_failed, member_step, norms,
         pairs_pooled, pairs_full, levels, record, bin_flush, end_flush, windows_flush)
     return keyed_cache(soa_kernel, key), keyed_cache(reference_kernel,
                                                      kernel_key(key, "reference"))

@@ -3,9 +3,8 @@
 ``step`` applies one step of a tableau ``(A, b, c)`` given as run-time arrays (a new
 scheme never recompiles); ``integrate_kernel`` runs it over a trajectory, storing state,
 residual and energy every ``save_every`` steps, and projecting after each step when asked.
-The multiply-adds
-are fused (:mod:`.fma`) at the same places as in the ensemble kernel's generated step
-(:mod:`.ensemble`), so that both give the same bits.
+The multiply-adds are fused (:mod:`.fma`) at the same places as in the ensemble kernel's
+generated step (:mod:`.ensemble`), so that both give the same bits.
 """
 
 from __future__ import annotations

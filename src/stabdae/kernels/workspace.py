@@ -28,8 +28,8 @@ from numba.extending import intrinsic
 
 from .source import exec_source
 
-__all__ = ["LAYOUT", "Workspace", "builders", "copy_inputs", "sizes", "stack1", "stack2",
-           "stack_int1"]
+__all__ = ["LAYOUT", "Workspace", "builders", "copy_inputs", "copy_tableau", "sizes", "stack1",
+           "stack2", "stack_int1"]
 
 #: (name, shape in the sizes of :func:`sizes`, what it holds)
 LAYOUT = (
@@ -196,3 +196,14 @@ def copy_inputs(p, law_mat, law_scal, p_s, lm, ls):
         for j in range(lm.shape[1]):
             lm[i, j] = law_mat[i, j]
     ls[0] = law_scal[0]
+
+
+@njit(forceinline=True)
+def copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc):
+    """Copy a scheme's run-time tableau into the caller's stack arrays (as
+    :func:`copy_inputs`, for the same reason)."""
+    for i in range(tb.shape[0]):
+        tb[i] = tab_b[i]
+        tc[i] = tab_c[i]
+        for j in range(tb.shape[0]):
+            ta[i, j] = tab_a[i, j]
