@@ -410,7 +410,7 @@ def test_time_dependent_model_stage_times_equal_single_integrations(spec):
 
 def test_reference_residuals_are_those_of_integrate():
     """Each member's decay is measured on its distance from the residual of the trajectory
-    from the reference state.  Its kernel (the step and the residual alone) gives
+    from the reference state.  Its run (the ensemble kernel with that one member) gives
     ``integrate``'s residual at every step bit for bit, sample and stage times included
     (a time-dependent model: a residual at the wrong time differs at once)."""
     from stabdae._ensemble import _reference_residuals
@@ -592,8 +592,6 @@ def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
     one decaying with rises and one that jumps several bins at once, against the sums
     taken pair by pair."""
     B, ng = 2, 2
-    norms, pairs_pooled, _, levels, record, bin_flush, end_flush, _, _ = decay.block_measures(
-        B, ng, 1)  # fmt: skip
 
     @njit
     def run(G):  # G[k, l, j]: the residual of member j at measured state k
@@ -606,17 +604,19 @@ def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
         active = np.ones(B, np.bool_)
         for k in range(G.shape[0]):
             Dv[:, :] = G[k]
-            norms(Dv, gr, gn, dn)
+            decay.difference_norms(Dv, gr, gn, dn)
             if k == 0:
                 for j in range(B):
                     base[j] = decay.ladder_base(dn[j])
                     low[j] = decay.ladder_level(dn[j], base[j]) >> decay.MAP_SHIFT
-            pairs_pooled(Dv, P, A, 1.0 if k > 0 else 0.0)
-            changed = levels(gn, dn, base, low, nlev, wmax, dmax)
+            decay.pairs_pooled(Dv, P, A, 1.0 if k > 0 else 0.0, 1)
+            changed = decay.block_levels(gn, dn, base, low, nlev, wmax, dmax)
             if changed != 0:
-                bin_flush(S, A, nlev, low, changed, 1)
-            record(lt, lv, dn, nlev, float(k))
-        end_flush(S, A, low, active, 1)
+                decay.bin_flush(S, A, nlev, low, changed, 1, 0)
+            for j in range(B):
+                lt[j, nlev[j]] = float(k)
+                lv[j, nlev[j]] = dn[j]
+        decay.end_flush(S, A, low, active, 1, 0)
         return S, base
 
     rng = np.random.default_rng(2)
@@ -1071,3 +1071,23 @@ def test_roundoff_level_of_the_pendulum_is_its_closed_form():
         assert _measures.roundoff_level(rows, X[i : i + 1], 0.7) == pytest.approx(
             u * each[i], rel=1e-6)
     assert _measures.roundoff_level(rows, X[:0], 0.7) == 0.0
+
+
+def test_residual_rows_by_the_sampler_are_those_of_their_kernel():
+    """An ensemble that sampled its members evaluates the roundoff level's residual rows
+    with the sampler it has compiled (placing skipped): the same numbers, bit for bit, as
+    the kernel for residual rows, at a time of its own (a time-dependent model), through
+    a non-finite row, on more rows than one chunk, and the caller's states untouched."""
+    from stabdae import _ensemble
+
+    model = load_scene("pendulum_varying_length")
+    p = model.param_vector(None)
+    X = np.random.default_rng(4).normal(size=(150, 2 * model.n))
+    X[7, 1] = np.nan
+    before = X.copy()
+    by_kernel = _ensemble._residual_rows(model, X, p, 0.37)
+    by_sampler = _ensemble._residual_rows(model, X, p, 0.37, sampler=True)
+    np.testing.assert_array_equal(by_sampler, by_kernel)
+    assert np.isnan(by_sampler[7]).any() and np.isfinite(np.delete(by_sampler, 7, 0)).all()
+    np.testing.assert_array_equal(X, before)
+    assert not np.array_equal(by_kernel, _ensemble._residual_rows(model, X, p, 0.0))

@@ -15,6 +15,7 @@ import math
 import time
 import warnings
 from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import xarray as xr
@@ -28,7 +29,7 @@ from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_
 from ._status import Status
 from .kernels import decay
 from .kernels.adaptive import LANES, adaptive_block_for
-from .kernels.ensemble import BLOCK, ensemble_kernel_for, reference_kernel_for
+from .kernels.ensemble import BLOCK, ensemble_kernel_for
 from .kernels.sampler import (
     CHUNK,
     SAMPLING_RTOL,
@@ -107,24 +108,50 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
     return _place(model, targets, p, t0, threads)
 
 
-def _place(model, targets, p, t0, threads=None):
+def _place(model, targets, p, t0, threads=None, beside=None):
+    """The members placed at the targets ``α⁰`` (:mod:`.kernels.sampler`):
+    ``(x0, alpha0, status)``.  With ``beside`` (a function of no arguments) the placing
+    runs on a thread of its own while ``beside()`` runs on this one, and its result comes
+    fourth: the ensemble's reference trajectory, whose first call for a new model compiles
+    the ensemble kernel, seconds during which the placing costs nothing.  (numba compiles
+    under a process-wide lock, so the sampler is compiled first, here.)"""
     sampler = sampler_for(model)
     M = targets.shape[0]
     x0 = np.empty((M, 2 * model.n))
     alpha0 = np.empty_like(targets)
     status = np.zeros(M, dtype=np.int8)
     x_ref = model.reference_state(p)
-    run_chunks(
-        lambda lo, hi: sampler(x_ref, t0, p, targets, x0, alpha0, status, lo, hi),
-        -(-M // CHUNK), threads=threads,
-    )  # fmt: skip
-    return x0, alpha0, status
+
+    def chunk(lo, hi):
+        sampler(x_ref, t0, p, targets, True, x0, alpha0, status, lo, hi)
+
+    items = -(-M // CHUNK)
+    if beside is None:
+        run_chunks(chunk, items, threads=threads)
+        return x0, alpha0, status
+    chunk(0, 0)
+    with ThreadPoolExecutor(1, thread_name_prefix="stabdae-place") as pool:
+        placing = pool.submit(run_chunks, chunk, items, threads=threads)
+        other = beside()
+        placing.result()
+    return x0, alpha0, status, other
 
 
-def _residual_rows(model, x, p, t0, threads=None):
-    """``g(x_i, t0)`` for every row of ``x`` (compiled; NaN rows give NaN)."""
-    kernel = residual_rows_for(model)
+def _residual_rows(model, x, p, t0, threads=None, sampler=False):
+    """``g(x_i, t0)`` for every row of ``x`` (compiled; NaN rows give NaN); by the
+    model's sampler when ``sampler`` (an ensemble that sampled its members has it
+    compiled: the same numbers, without compiling a kernel for them)."""
     out = np.empty((x.shape[0], model.n_residual))
+    if sampler:
+        kernel = sampler_for(model)
+        x = np.array(x, dtype=float, order="C")  # (rows evaluated in place)
+        none = np.empty((x.shape[0], 0))
+        status = np.empty(x.shape[0], dtype=np.int8)
+        unused = np.zeros(x.shape[1])  # (the state placing starts from)
+        run_chunks(lambda lo, hi: kernel(unused, t0, p, none, False, x, out, status, lo, hi),
+                   -(-x.shape[0] // CHUNK), threads=threads)  # fmt: skip
+        return out
+    kernel = residual_rows_for(model)
     run_chunks(lambda lo, hi: kernel(x, t0, p, out, lo, hi), -(-x.shape[0] // CHUNK),
                threads=threads)  # fmt: skip
     return out
@@ -287,12 +314,17 @@ def ensemble(
 
     clock = time.perf_counter()
     g_ref = np.zeros((0, model.n_residual))
-    if x0 is None:
+    sampled = x0 is None
+    if sampled:
         targets = draw_alphas(model.n_residual, members, (low, high),
                               np.random.default_rng(seed))  # fmt: skip
-        x0, alpha0, status = _place(model, targets, p, t0, threads)
-        if not adaptive:
-            g_ref = _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block)
+        if adaptive:
+            x0, alpha0, status = _place(model, targets, p, t0, threads)
+        else:
+            x0, alpha0, status, g_ref = _place(
+                model, targets, p, t0, threads,
+                beside=lambda: _reference_residuals(model, bound, scheme, p, t0, tau, nsteps,
+                                                    block, rdtype))  # fmt: skip
     else:
         alpha0 = _residual_rows(model, x0, p, t0, threads)
         status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
@@ -328,7 +360,7 @@ def ensemble(
                 threads=threads if threads is not None else default_threads()),
         extra=out.get("extra"), overshoot_theory=peak,
         roundoff=_roundoff(model, out["x_final"], status, p, float(out["times"][-1]), gain,
-                           threads),
+                           threads, sampled),
     )  # fmt: skip
     if not states:
         ds = ds.drop_vars(["x0", "x_final"])
@@ -339,23 +371,31 @@ def ensemble(
     return ds
 
 
-def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK):
+def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK,
+                         rdtype=np.float32):  # fmt: skip
     """The residual ``g`` at every step of the trajectory from the model's reference state
     (``α⁰ = 0``): the truncation error's forced response, the same for every member of a
     sampled ensemble up to ``O(‖α⁰‖)``.  Each member's decay is measured on its distance
     from it, so that the rate is read far below the floor the raw residual settles on.
     None (an empty array: the raw residual is measured) when it would take more than
-    ``REFERENCE_MAX_ENTRIES`` numbers or does not run to the end.  (Stepped by the
-    ensemble kernel's own member step, which the kernel of ``block`` members then reuses
-    compiled: a stepper of its own was another quarter of a new model's first compile.)"""
+    ``REFERENCE_MAX_ENTRIES`` numbers or does not run to the end.  (A run of the ensemble
+    kernel itself with this one member, which records its residual at every step: a
+    kernel of its own cost a new model's first ensemble seconds of compilation, more
+    than the block of identical slots this run steps costs at any ensemble size; its
+    storage type ``rdtype`` is the ensemble's, for the same compiled kernel.)"""
     ng = model.n_residual
     if (nsteps + 1) * ng > REFERENCE_MAX_ENTRIES:
         return np.zeros((0, ng))
-    kernel = reference_kernel_for(model, bound, scheme, block)
+    kernel = ensemble_kernel_for(model, bound, scheme, block)
+    x0 = model.reference_state(p)[None, :]
+    out = _outputs(x0, 0, 2, rdtype)
     out_g = np.full((nsteps + 1, ng), np.nan)
-    status, _ = kernel(model.reference_state(p), t0, tau, nsteps, p, bound.matrix,
-                       bound.scalars, scheme.A, scheme.b, scheme.c, out_g)  # fmt: skip
-    if status != 0 or not np.isfinite(out_g).all():
+    kernel(x0, np.zeros((1, ng)), t0, tau, nsteps, nsteps, p, bound.matrix, bound.scalars,
+           scheme.A, scheme.b, scheme.c, math.inf, np.zeros((0, ng)), np.zeros((0, 0)),
+           nsteps + 1, np.full(1, -1, dtype=np.int64), out["norms"], out["meas"],
+           out["x_final"], out["status"], out["fail_step"], out["e0"], out["e1"], out_g,
+           0, 1)  # fmt: skip
+    if out["status"][0] != 0 or not np.isfinite(out_g).all():
         return np.zeros((0, ng))
     return out_g
 
@@ -415,6 +455,7 @@ def _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every,
     kernel = ensemble_kernel_for(model, bound, scheme, block)
     alpha0 = np.ascontiguousarray(alpha0)
     stride = measure_stride(R)
+    no_residuals = np.zeros((0, model.n_residual))
     R_stride = np.ascontiguousarray(np.linalg.matrix_power(R, stride)) if R.size else R
     out["stride"] = stride
 
@@ -423,7 +464,7 @@ def _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every,
                scheme.A, scheme.b, scheme.c, divergence, g_ref, R_stride, stride,
                trace_row, out["norms"],
                out["meas"], out["x_final"], out["status"], out["fail_step"], out["e0"],
-               out["e1"], lo, hi)  # fmt: skip
+               out["e1"], no_residuals, lo, hi)  # fmt: skip
 
     run_chunks(
         chunk, -(-M // block), threads=threads,
@@ -505,18 +546,19 @@ def _warn_stopped(model, status) -> None:
 ROUNDOFF_SAMPLE = 16
 
 
-def _roundoff(model, x_final, status, p, t, gain, threads):
+def _roundoff(model, x_final, status, p, t, gain, threads, sampled=False):
     """What roundoff can build up in the residual by the end of the run: its level at the
     final states of up to ``ROUNDOFF_SAMPLE`` members that ran to the end, evenly spaced
     (:func:`._measures.roundoff_level`), accumulated by the law's recursion (``gain``,
-    :func:`.theory.forced_gain`; once where it is unknown or unbounded)."""
+    :func:`.theory.forced_gain`; once where it is unknown or unbounded).  ``sampled``:
+    the members were sampled (:func:`_residual_rows` by the sampler)."""
     ran = np.flatnonzero(status == 0)
     if ran.size == 0:
         return 0.0
     pick = ran[np.unique(np.linspace(0, ran.size - 1, min(ROUNDOFF_SAMPLE, ran.size))
                          .astype(int))]  # fmt: skip
     level = _measures.roundoff_level(
-        lambda X, at: _residual_rows(model, np.ascontiguousarray(X), p, at, threads),
+        lambda X, at: _residual_rows(model, np.ascontiguousarray(X), p, at, threads, sampled),
         x_final[pick], t)  # fmt: skip
     return level * (gain if math.isfinite(gain) else 1.0)
 

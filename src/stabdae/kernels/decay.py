@@ -806,201 +806,204 @@ trailing_zeros = _trailing_zeros_python if config.DISABLE_JIT else _numba_traili
 trailing_zeros.__doc__ = """The index of the lowest set bit of a non-zero int64."""
 
 
-def block_measures(B: int, ng: int, pm: int):
-    """The decay measurement of a block of ``B`` members in lockstep, for a residual of
-    ``ng`` components, the first ``2 pm`` of them ``(f, ḟ)`` (``pm`` the model's number
-    of holonomic constraints).
+def full_rows(ng: int) -> int:
+    """The rows of the full one-step map's running sums (:func:`pairs_full`) for a residual
+    of ``ng`` components: Σ p pᵀ's upper triangle, Σ p' pᵀ, the count; 1 when
+    ``ng > MAP_MAX_NG`` (no full map)."""
+    return ng * (ng + 1) // 2 + ng * ng + 1 if ng <= MAP_MAX_NG else 1
 
-    What :func:`observe` and the one-step map's sums do member by member, here for the
-    whole block at once, in loops over its members (structure of arrays, member index
-    innermost: they vectorize), with the scattered writes deferred:
 
-    * the ladder: each member's level (``levels``, vectorized), then the time and norm
-      written on it (``record``, a scatter);
-    * the one-step map: the pairs' running sums in ``A`` (a row per sum, the symmetric
-      ``Σ p pᵀ`` once), copied to the member's row of ``S`` for each bin its level goes
-      below for the first time (``bin_flush``: a scalar loop over the members whose bit
-      is set in the mask ``levels`` returns; a member crosses each bin once, where a
-      flush at every change of bin came at every few measured states of a residual on
-      its floor), and at the end for the bins it never went below (``end_flush``);
-    * the largest norms of the current fifth of the run in ``wmax`` and ``dmax``, written
-      to the member's row when the fifth ends or the member stops (``windows_flush``).
+# The decay measurement of a block of members in lockstep (the ensemble kernel's): what
+# :func:`observe` and the one-step map's sums do member by member, here for the whole block
+# at once, in loops over its members (structure of arrays, member index innermost: they
+# vectorize), with the scattered writes deferred:
+#
+# * the ladder: each member's level (``block_levels``, vectorized), then the time and norm
+#   written on it (by the kernel, a scatter);
+# * the one-step map: the pairs' running sums in ``A`` (a row per sum, the symmetric
+#   ``Σ p pᵀ`` once), copied to the member's row of ``S`` for each bin its level goes below
+#   for the first time (``bin_flush``: a scalar loop over the members whose bit is set in
+#   the mask ``block_levels`` returns; a member crosses each bin once, where a flush at
+#   every change of bin came at every few measured states of a residual on its floor), and
+#   at the end for the bins it never went below (``end_flush``);
+# * the largest norms of the current fifth of the run in ``wmax`` and ``dmax``, written to
+#   the member's row when the fifth ends or the member stops (``windows_flush``).
+#
+# The ladder is :func:`observe`'s; bin ``b`` of the map's sums holds the pairs whose first
+# state came before the member's level first went below bin ``b`` (:func:`map_buffers`).
+# The block's size, the residual's and the constraints' come from the arrays' shapes and
+# the arguments, not from a closure: a closure per model was compiled on its own at each
+# new model's first ensemble (about a second in all).  Compiled once for every model
+# (cached) and inlined into the kernel, whose buffers have constant shapes.  (The
+# ladder's scatter is written in the kernel itself: optimized on its own first, over an
+# unknown block size, it lost its vectorization, a tenth of a pendulum's kernel time.)
 
-    The ladder is :func:`observe`'s; bin ``b`` of the map's sums holds the pairs whose
-    first state came before the member's level first went below bin ``b``
-    (:func:`map_buffers`).  Returns ``(norms, pairs_pooled, pairs_full, levels, record, bin_flush,
-    end_flush, windows_flush, rows_full)``, ``rows_full`` the rows of the full map's ``A`` (1 when
-    ``ng > MAP_MAX_NG``: no full map)."""
-    PM, NH = pm, ng - 2 * pm
-    FULL = ng if ng <= MAP_MAX_NG else 0
-    ROWS_FULL = FULL * (FULL + 1) // 2 + FULL * FULL + 1 if FULL else 1
 
-    @njit(forceinline=True, error_model="numpy")
-    def norms(Dv, gr, gn, dn):
-        """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
-        norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
+@njit(cache=True, forceinline=True, error_model="numpy")
+def difference_norms(Dv, gr, gn, dn):
+    """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
+    norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
+    ng, B = Dv.shape
+    for j in range(B):
+        gn[j] = 0.0
+        dn[j] = 0.0
+    for l in range(ng):
+        r = gr[l]
         for j in range(B):
-            gn[j] = 0.0
-            dn[j] = 0.0
-        for l in range(ng):
-            r = gr[l]
-            for j in range(B):
-                g = Dv[l, j]
-                d = g - r
-                Dv[l, j] = d
-                gn[j] = max(gn[j], abs(g))
-                dn[j] = max(dn[j], abs(d))
+            g = Dv[l, j]
+            d = g - r
+            Dv[l, j] = d
+            gn[j] = max(gn[j], abs(g))
+            dn[j] = max(dn[j], abs(d))
 
-    @njit(forceinline=True, error_model="numpy")
-    def pairs_pooled(Dv, P, A, w):
-        """The pairs (``P``: the previous measured residuals, ``Dv``: the current) added
-        with weight ``w`` (0: no previous one yet) to the pooled sums (10 rows: Σ p pᵀ's
-        3, Σ p' pᵀ's 4 over ``p = (f_i, ḟ_i)``, Σ h², Σ h' h, the count); then
-        ``P = Dv``."""
-        for i in range(PM):
-            for j in range(B):
-                a0 = P[i, j]
-                a1 = P[PM + i, j]
-                c0 = Dv[i, j]
-                c1 = Dv[PM + i, j]
-                A[0, j] += w * (a0 * a0)
-                A[1, j] += w * (a0 * a1)
-                A[2, j] += w * (a1 * a1)
-                A[3, j] += w * (c0 * a0)
-                A[4, j] += w * (c0 * a1)
-                A[5, j] += w * (c1 * a0)
-                A[6, j] += w * (c1 * a1)
-        for i in range(2 * PM, 2 * PM + NH):
-            for j in range(B):
-                A[7, j] += w * (P[i, j] * P[i, j])
-                A[8, j] += w * (Dv[i, j] * P[i, j])
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def pairs_pooled(Dv, P, A, w, pm):
+    """The pairs (``P``: the previous measured residuals, ``Dv``: the current; their first
+    ``2 pm`` rows ``(f, ḟ)``, ``pm`` the holonomic constraints) added with weight ``w`` (0:
+    no previous one yet) to the pooled sums (10 rows: Σ p pᵀ's 3, Σ p' pᵀ's 4 over
+    ``p = (f_i, ḟ_i)``, Σ h², Σ h' h, the count); then ``P = Dv``."""
+    ng, B = Dv.shape
+    for i in range(pm):
         for j in range(B):
-            A[9, j] += w
-        for l in range(ng):
-            for j in range(B):
-                P[l, j] = Dv[l, j]
+            a0 = P[i, j]
+            a1 = P[pm + i, j]
+            c0 = Dv[i, j]
+            c1 = Dv[pm + i, j]
+            A[0, j] += w * (a0 * a0)
+            A[1, j] += w * (a0 * a1)
+            A[2, j] += w * (a1 * a1)
+            A[3, j] += w * (c0 * a0)
+            A[4, j] += w * (c0 * a1)
+            A[5, j] += w * (c1 * a0)
+            A[6, j] += w * (c1 * a1)
+    for i in range(2 * pm, ng):
+        for j in range(B):
+            A[7, j] += w * (P[i, j] * P[i, j])
+            A[8, j] += w * (Dv[i, j] * P[i, j])
+    for j in range(B):
+        A[9, j] += w
+    for l in range(ng):
+        for j in range(B):
+            P[l, j] = Dv[l, j]
 
-    @njit(forceinline=True, error_model="numpy")
-    def pairs_full(Dv, P, A, w):
-        """As ``pairs_pooled`` for the full map: Σ p pᵀ (upper triangle), Σ p' pᵀ, the
-        count."""
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def pairs_full(Dv, P, A, w):
+    """As :func:`pairs_pooled` for the full map (``A``: :func:`full_rows` rows): Σ p pᵀ
+    (upper triangle), Σ p' pᵀ, the count."""
+    ng, B = Dv.shape
+    c = 0
+    for r in range(ng):
+        for q in range(r, ng):
+            for j in range(B):
+                A[c, j] += w * (P[r, j] * P[q, j])
+            c += 1
+    for r in range(ng):
+        for q in range(ng):
+            for j in range(B):
+                A[c, j] += w * (Dv[r, j] * P[q, j])
+            c += 1
+    for j in range(B):
+        A[c, j] += w
+    for l in range(ng):
+        for j in range(B):
+            P[l, j] = Dv[l, j]
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def block_levels(gn, dn, base, low, nlev, wmax, dmax):
+    """The block's norms ``gn`` (of ``g``) and ``dn`` (measured) at a state: the largest of
+    the fifth, each slot's ladder level into ``nlev`` (``NBINS``, the ladder's spare
+    column, for a non-finite norm, which :func:`observe` leaves out); returns a mask of
+    the slots whose level went below ``low``, the lowest of the map's bins they had
+    reached (at most 64 slots)."""
+    changed = 0
+    for j in range(gn.shape[0]):
+        v = gn[j]
+        wm = wmax[j]
+        wmax[j] = v if (v < math.inf and not (wm >= v)) else wm
+        d = dn[j]
+        ok = d < math.inf
+        dm = dmax[j]
+        dmax[j] = d if (ok and not (dm >= d)) else dm
+        b = ladder_level(d, base[j])
+        nlev[j] = b if ok else NBINS
+        lower = ok and (b >> MAP_SHIFT) < low[j]
+        changed |= (1 if lower else 0) << j
+    return changed
+
+
+@njit(cache=True, forceinline=True)
+def _store(S, A, j, bin_, pooled, full):
+    """Slot ``j``'s sums so far as those of its bin ``bin_`` (``pooled ≥ 0``: the pooled
+    map's; else the full map's of ``full`` components, none when 0)."""
+    if pooled >= 0:
+        S[j, bin_, 0] = A[0, j]
+        S[j, bin_, 1] = A[1, j]
+        S[j, bin_, 2] = A[1, j]
+        S[j, bin_, 3] = A[2, j]
+        for c in range(4):
+            S[j, bin_, 4 + c] = A[3 + c, j]
+        S[j, bin_, 8] = A[7, j]
+        S[j, bin_, 9] = A[8, j]
+        S[j, bin_, 10] = A[9, j]
+    elif full:
         c = 0
-        for r in range(FULL):
-            for q in range(r, FULL):
-                for j in range(B):
-                    A[c, j] += w * (P[r, j] * P[q, j])
+        for r in range(full):
+            for q in range(r, full):
+                S[j, bin_, r * full + q] = A[c, j]
+                if q != r:
+                    S[j, bin_, q * full + r] = A[c, j]
                 c += 1
-        for r in range(FULL):
-            for q in range(FULL):
-                for j in range(B):
-                    A[c, j] += w * (Dv[r, j] * P[q, j])
-                c += 1
-        for j in range(B):
-            A[ROWS_FULL - 1, j] += w
-        for l in range(ng):
-            for j in range(B):
-                P[l, j] = Dv[l, j]
+        for r in range(full * full):
+            S[j, bin_, full * full + r] = A[c, j]
+            c += 1
+        S[j, bin_, 2 * full * full] = A[c, j]
 
-    @njit(forceinline=True, error_model="numpy")
-    def levels(gn, dn, base, low, nlev, wmax, dmax):
-        """The block's norms ``gn`` (of ``g``) and ``dn`` (measured) at a state: the
-        largest of the fifth, each slot's ladder level into ``nlev`` (``NBINS``, the
-        ladder's spare column, for a non-finite norm, which :func:`observe` leaves out);
-        returns a mask of the slots whose level went below ``low``, the lowest of the
-        map's bins they had reached."""
-        changed = 0
-        for j in range(B):
-            v = gn[j]
-            wm = wmax[j]
-            wmax[j] = v if (v < math.inf and not (wm >= v)) else wm
-            d = dn[j]
-            ok = d < math.inf
-            dm = dmax[j]
-            dmax[j] = d if (ok and not (dm >= d)) else dm
-            b = ladder_level(d, base[j])
-            nlev[j] = b if ok else NBINS
-            lower = ok and (b >> MAP_SHIFT) < low[j]
-            changed |= (1 if lower else 0) << j
-        return changed
 
-    @njit(forceinline=True)
-    def record(lt, lv, dn, nlev, t):
-        """Time ``t`` and norm on each slot's level (a scatter, apart from the vectorized
-        loops)."""
-        for j in range(B):
-            b = nlev[j]
-            lt[j, b] = t
-            lv[j, b] = dn[j]
+@njit(cache=True, error_model="numpy")
+def bin_flush(S, A, nlev, low, mask, pooled, full):
+    """The slots of the set bits of ``mask``, whose level went below the lowest bin they
+    had reached: their sums so far (the pair just added, from a state above, included)
+    become those of each bin passed, down to the new one's, which is then the lowest
+    (``pooled``, ``full``: :func:`_store`)."""
+    while mask != 0:
+        j = trailing_zeros(mask)
+        mask &= mask - 1
+        nb = nlev[j] >> MAP_SHIFT
+        for b in range(nb + 1, low[j] + 1):
+            _store(S, A, j, b, pooled, full)
+        low[j] = nb
 
-    @njit(forceinline=True)
-    def _store(S, A, j, bin_, pooled):
-        """Slot ``j``'s sums so far as those of its bin ``bin_``."""
-        if pooled >= 0:
-            S[j, bin_, 0] = A[0, j]
-            S[j, bin_, 1] = A[1, j]
-            S[j, bin_, 2] = A[1, j]
-            S[j, bin_, 3] = A[2, j]
-            for c in range(4):
-                S[j, bin_, 4 + c] = A[3 + c, j]
-            S[j, bin_, 8] = A[7, j]
-            S[j, bin_, 9] = A[8, j]
-            S[j, bin_, 10] = A[9, j]
-        elif FULL:
-            c = 0
-            for r in range(FULL):
-                for q in range(r, FULL):
-                    S[j, bin_, r * FULL + q] = A[c, j]
-                    if q != r:
-                        S[j, bin_, q * FULL + r] = A[c, j]
-                    c += 1
-            for r in range(FULL * FULL):
-                S[j, bin_, FULL * FULL + r] = A[c, j]
-                c += 1
-            S[j, bin_, 2 * FULL * FULL] = A[c, j]
 
-    @njit(error_model="numpy")
-    def bin_flush(S, A, nlev, low, mask, pooled):
-        """The slots of the set bits of ``mask``, whose level went below the lowest bin
-        they had reached: their sums so far (the pair just added, from a state above,
-        included) become those of each bin passed, down to the new one's, which is then
-        the lowest."""
-        while mask != 0:
-            j = trailing_zeros(mask)
-            mask &= mask - 1
-            nb = nlev[j] >> MAP_SHIFT
-            for b in range(nb + 1, low[j] + 1):
-                _store(S, A, j, b, pooled)
-            low[j] = nb
+@njit(cache=True, error_model="numpy")
+def end_flush(S, A, low, active, pooled, full):
+    """At the end of the run: each running slot's sums as those of the bins it did not go
+    below."""
+    for j in range(low.shape[0]):
+        if active[j]:
+            for b in range(low[j] + 1):
+                _store(S, A, j, b, pooled, full)
 
-    @njit(error_model="numpy")
-    def end_flush(S, A, low, active, pooled):
-        """At the end of the run: each running slot's sums as those of the bins it did not
-        go below."""
-        for j in range(B):
-            if active[j]:
-                for b in range(low[j] + 1):
-                    _store(S, A, j, b, pooled)
 
-    @njit(error_model="numpy")
-    def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
-        """The largest norms of fifth ``window`` so far to the rows of the running
-        members; then cleared."""
-        for j in range(cnt):
-            if active[j]:
-                row = lo + j
-                c = C_W0 + window
-                if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
-                    meas[row, c] = wmax[j]
-                if window >= 2:
-                    c = C_D2 + window - 2
-                    if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
-                        meas[row, c] = dmax[j]
-        for j in range(B):
-            wmax[j] = -math.inf
-            dmax[j] = -math.inf
-
-    return (norms, pairs_pooled, pairs_full, levels, record, bin_flush, end_flush,
-            windows_flush, ROWS_FULL)
+@njit(cache=True, error_model="numpy")
+def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
+    """The largest norms of fifth ``window`` so far to the rows of the running members;
+    then cleared."""
+    for j in range(cnt):
+        if active[j]:
+            row = lo + j
+            c = C_W0 + window
+            if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
+                meas[row, c] = wmax[j]
+            if window >= 2:
+                c = C_D2 + window - 2
+                if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
+                    meas[row, c] = dmax[j]
+    for j in range(wmax.shape[0]):
+        wmax[j] = -math.inf
+        dmax[j] = -math.inf
 
 
 @njit(cache=True)

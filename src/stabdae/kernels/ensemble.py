@@ -57,19 +57,27 @@ from numba import njit
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
 from .decay import (
+    MAP_MAX_NG,
     MAP_SHIFT,
     begin,
-    block_measures,
+    bin_flush,
+    block_levels,
+    difference_norms,
+    end_flush,
     finish_with_map,
+    full_rows,
     ladder_base,
     ladder_level,
     ladders,
     map_begin,
     map_buffers,
     observe,
+    pairs_full,
+    pairs_pooled,
     predict,
     scratch,
     spectral_radius_of,
+    windows_flush,
 )
 from .fma import fma
 from .rhs import kernels_for
@@ -172,7 +180,9 @@ def _member_step(rhs, N2: int, NG: int, pattern):
     label = "member_step_" + "".join(map(str, sum(pattern[0], ()) + pattern[1]))
     ns = exec_source(_member_step_source(pattern, N2), label,
                      {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": NG, "fma": fma})  # fmt: skip
-    return njit(forceinline=True, error_model="numpy")(ns["member_step"])
+    # inlined by numba into the kernel's member loop (its one call), not compiled on its
+    # own and then again inside the kernel: half a second of a new model's first ensemble
+    return njit(inline="always", error_model="numpy")(ns["member_step"])
 
 
 def pooled_constraints(model, law) -> int:
@@ -201,18 +211,6 @@ def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the kinds of
     the scheme's coefficients, block, the shape of the law's matrix and whether the decay
     measurement pools the constraints, :func:`pooled_constraints`)."""
-    return _kernels(model, bound, scheme, block)[0]
-
-
-def reference_kernel_for(model, bound, scheme, block: int = BLOCK):
-    """``kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c, out_g)``:
-    the residual at every step of one trajectory, ``(status, steps completed)``, by the
-    step of :func:`ensemble_kernel_for`'s kernel (the ensemble's reference trajectory;
-    the step compiles once for both)."""
-    return _kernels(model, bound, scheme, block)[1]
-
-
-def _kernels(model, bound, scheme, block):
     pattern = tableau_pattern(scheme)
     shape = bound.matrix.shape
     n_params = len(model.param_names)
@@ -222,6 +220,70 @@ def _kernels(model, bound, scheme, block):
                                          shape, pooled))  # fmt: skip
 
 
+# The block's bookkeeping at checks and stops: sizes from the arrays, so that these are
+# compiled once (cached) for every model rather than as closures at each new model's first
+# ensemble.
+
+
+@njit(cache=True, error_model="numpy")
+def retire(X, j, row, active, code, x_final, x_last):
+    """Stop slot ``j``.  Its member, output ``row`` (``-1``: padding, or a slot that
+    was already stopped), gets ``x_last`` as its final state; the slot then takes the
+    state of a running member whose last step succeeded, so that it computes harmless
+    numbers from now on instead of failing at every step."""
+    if row >= 0:
+        for l in range(X.shape[0]):
+            x_final[row, l] = x_last[l]
+    active[j] = False
+    for src in range(active.shape[0]):
+        if active[src] and code[src] == 0:
+            for l in range(X.shape[0]):
+                X[l, j] = X[l, src]
+            break
+
+
+@njit(cache=True, error_model="numpy")
+def stop_failed(X, X_last, code, active, lo, cnt, step, status, fail_step, x_final,
+                x_last):  # fmt: skip
+    """Stop every slot with a status in ``code`` or a non-finite state: its member, if
+    still running, gets that status (``NONFINITE_STATE`` for the state), ``step`` as
+    its failing step and its column of ``X_last`` as final state; the slot is then
+    recycled (:func:`retire`).  Clears ``code``; returns the number of members
+    stopped."""
+    for j in range(code.shape[0]):
+        for l in range(X.shape[0]):
+            if code[j] == 0 and not math.isfinite(X[l, j]):
+                code[j] = _NONFINITE
+    stopped = 0
+    for j in range(code.shape[0]):
+        if code[j] != 0:
+            row = lo + j if (j < cnt and active[j]) else -1
+            if row >= 0:
+                status[row] = code[j]
+                fail_step[row] = step
+                stopped += 1
+            for l in range(X.shape[0]):
+                x_last[l] = X_last[l, j]
+            retire(X, j, row, active, code, x_final, x_last)
+    for j in range(code.shape[0]):
+        code[j] = 0
+    return stopped
+
+
+@njit(cache=True, error_model="numpy")
+def block_failed(X, code):
+    """Whether a slot's steps since the last check failed: a status in ``code`` or a
+    non-finite state (which stays non-finite once it is).  (Slots innermost: the loops
+    vectorize over any block size.)"""
+    bad = False
+    for j in range(code.shape[0]):
+        bad |= code[j] != 0
+    for l in range(X.shape[0]):
+        for j in range(code.shape[0]):
+            bad |= not math.isfinite(X[l, j])
+    return bad
+
+
 def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1),
                      pooled: int = -1):  # fmt: skip
     """The block-lockstep ensemble kernel for the kernels ``K``, an explicit scheme whose
@@ -229,8 +291,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     ``block`` members, ``n_params`` parameters, a law matrix of shape ``law_shape`` and
     the decay measurement's one-step map pooled over ``pooled`` holonomic constraints
     (−1: the full map; :func:`.decay.map_width`), all fixed at compile time; the
-    scheme's coefficients, the parameters and the law's numbers are run-time arrays.
-    Returns it and the reference trajectory's kernel (:func:`reference_kernel_for`)."""
+    scheme's coefficients, the parameters and the law's numbers are run-time arrays."""
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
     N2, ng = 2 * K.n, K.ng
@@ -240,15 +301,16 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     LR, LC = law_shape
     member_step = _member_step(rhs, N2, ng, pattern)
     stack_workspace = K.stack_workspace
-    (norms, pairs_pooled, pairs_full, levels, record, bin_flush, end_flush, windows_flush,
-     ROWS_FULL) = block_measures(B, ng, K.m)
+    ROWS_FULL = full_rows(ng)
+    FULL = ng if ng <= MAP_MAX_NG else 0  # the full map's components (none: 0)
     NA = 10 if pooled >= 0 else ROWS_FULL  # rows of the current bin visit's sums
 
     @njit(error_model="numpy")
-    def block_norms(X, t, p, gref, nrm, dnrm):
+    def block_norms(X, t, p, gref, nrm, dnrm, G):
         """``‖g‖∞`` and ``‖g − gref‖∞`` of every slot of the block at time ``t`` into
-        ``nrm`` and ``dnrm``: one loop over the slots, vectorized like the step's (cheaper
-        than one scalar evaluation per running member)."""
+        ``nrm`` and ``dnrm``, and ``g`` into the columns of ``G``: one loop over the
+        slots, vectorized like the step's (cheaper than one scalar evaluation per running
+        member)."""
         for j in range(B):
             ws = stack_workspace()
             xs = stack1(N2)
@@ -261,107 +323,14 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             for l in range(ng):
                 s = max(s, abs(gj[l]))
                 d = max(d, abs(gj[l] - gref[l]))
+                G[l, j] = gj[l]
             nrm[j] = s
             dnrm[j] = d
-
-    @njit(error_model="numpy")
-    def retire(X, j, row, active, code, x_final, x_last):
-        """Stop slot ``j``.  Its member, output ``row`` (``-1``: padding, or a slot that
-        was already stopped), gets ``x_last`` as its final state; the slot then takes the
-        state of a running member whose last step succeeded, so that it computes harmless
-        numbers from now on instead of failing at every step."""
-        if row >= 0:
-            for l in range(N2):
-                x_final[row, l] = x_last[l]
-        active[j] = False
-        for src in range(active.shape[0]):
-            if active[src] and code[src] == 0:
-                for l in range(N2):
-                    X[l, j] = X[l, src]
-                break
-
-    @njit(error_model="numpy")
-    def stop_failed(X, X_last, code, active, lo, cnt, step, status, fail_step, x_final,
-                    x_last):  # fmt: skip
-        """Stop every slot with a status in ``code`` or a non-finite state: its member, if
-        still running, gets that status (``NONFINITE_STATE`` for the state), ``step`` as
-        its failing step and its column of ``X_last`` as final state; the slot is then
-        recycled (:func:`retire`).  Clears ``code``; returns the number of members
-        stopped."""
-        for j in range(B):
-            for l in range(N2):
-                if code[j] == 0 and not math.isfinite(X[l, j]):
-                    code[j] = _NONFINITE
-        stopped = 0
-        for j in range(B):
-            if code[j] != 0:
-                row = lo + j if (j < cnt and active[j]) else -1
-                if row >= 0:
-                    status[row] = code[j]
-                    fail_step[row] = step
-                    stopped += 1
-                for l in range(N2):
-                    x_last[l] = X_last[l, j]
-                retire(X, j, row, active, code, x_final, x_last)
-        for j in range(B):
-            code[j] = 0
-        return stopped
-
-    @njit(error_model="numpy")
-    def block_failed(X, code):
-        """Whether a slot's steps since the last check failed: a status in ``code`` or a
-        non-finite state (which stays non-finite once it is)."""
-        bad = False
-        for j in range(code.shape[0]):
-            bad |= code[j] != 0
-            for l in range(N2):
-                bad |= not math.isfinite(X[l, j])
-        return bad
-
-    @njit(error_model="numpy")
-    def reference_kernel(x0, t0, tau, nsteps, p, law_mat, law_scal, tab_a, tab_b, tab_c,
-                         out_g):  # fmt: skip
-        """``g`` at every step of the trajectory from ``x0`` into the rows of ``out_g``
-        (rows after a failure are left untouched); ``(status, steps completed)``.  The
-        members' own step (``member_step``, one member), so that it is compiled once for
-        both kernels and gives the numbers a member from ``x0`` would."""
-        # the step's inputs on the stack, as in the ensemble kernel (a stack buffer lives
-        # in the frame that allocates it, so these lines cannot move into a helper)
-        p_s = stack1(NP)
-        lm = stack2(LR, LC)
-        ls = stack1(1)
-        copy_inputs(p, law_mat, law_scal, p_s, lm, ls)
-        ta = stack2(S_, S_)
-        tb = stack1(S_)
-        tc = stack1(S_)
-        copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc)
-        ws = stack_workspace()
-        xk = stack1(N2)
-        xs = stack1(N2)
-        xn = stack1(N2)
-        gv = stack1(ng)
-        for l in range(N2):
-            xk[l] = x0[l]
-        for i in range(1, nsteps + 1):
-            c = member_step(t0 + (i - 1) * tau, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn,
-                            gv)  # fmt: skip
-            for l in range(ng):  # g(x_{i-1}), evaluated by the step's first stage
-                out_g[i - 1, l] = gv[l]
-            if c != 0:
-                return c, i - 1
-            for l in range(N2):
-                if not math.isfinite(xn[l]):
-                    return _NONFINITE, i - 1
-                xk[l] = xn[l]
-        residual(t0 + nsteps * tau, xk, p_s, ws, gv)
-        for l in range(ng):
-            out_g[nsteps, l] = gv[l]
-        return 0, nsteps
 
     @njit(nogil=True, error_model="numpy")
     def soa_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
                    tab_b, tab_c, threshold, g_ref, R, stride, trace_row, out_norm, meas,
-                   x_final, status, fail_step, e0, e1, b_lo, b_hi):  # fmt: skip
+                   x_final, status, fail_step, e0, e1, g_out, b_lo, b_hi):  # fmt: skip
         """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
         :func:`stabdae.ensemble`.  Member ``i``'s stored samples go to row
         ``trace_row[i]`` of ``out_norm`` (none when −1); its decay measures
@@ -371,7 +340,9 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         ``stride``-th state, :func:`stabdae._ensemble.measure_stride`).  The decay is
         measured on
         ``‖g_k − g_ref[k]‖∞``, ``g_ref`` the residual of a reference trajectory at every
-        step (none when it has no rows: ``‖g_k‖∞``).
+        step (none when it has no rows: ``‖g_k‖∞``).  When ``g_out`` has rows, the
+        residual of the first member at every step goes to its rows (the reference
+        trajectory is such a run of one member: the same step, compiled once).
         Every output row of the blocks is written here (``out_norm`` NaN after a stop,
         ``status`` 0 and ``fail_step`` −1 for a member that runs to the end), so the
         driver allocates them empty and the pages are first touched by the threads
@@ -394,7 +365,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         X = stack2(N2, B)
         Xc = stack2(N2, B)
         code = stack_int1(B)
-        active = np.zeros(B, dtype=np.bool_)  # members (not padding) still running
+        active = stack_int1(B)  # members (not padding) still running: 1, else 0
         ws_h = K_make_workspace()
         xs_h = np.empty(N2)
         nrm_b = np.empty(B)  # the block's residual norms at a stored sample
@@ -403,17 +374,24 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         ds = stack1(B)  # ... and its distance from the reference's
         has_ref = g_ref.shape[0] > 0
         gr = stack1(ng)  # the reference's residual at the current step
+        has_out = g_out.shape[0] > 0
+        Gb = stack2(ng, B)  # the block's residuals at a stored sample
         for l in range(ng):
             gr[l] = 0.0
         lt, lv, base = ladders(B)  # the decay measurement's ladder per slot
         rt, ry, fa, fb, lg = scratch()
-        # The measurement (:func:`.decay.block_measures`): the one-step map's sums per
+        # The measurement (the block functions of :mod:`.decay`): the one-step map's sums per
         # slot and bin, fed from the measured states' g − g_ref (Dv: each step's g, made
         # g − g_ref, with the norms gs, ds, at a measured one) through the previous one
         # (P) and the running sums (Am); each slot's ladder offset, the lowest of the
         # map's bins it reached and its level at this state; the largest norms of the
         # fifth.
         S_map = map_buffers(B, ng, pooled)
+        # the measurement's sizes as run-time integers: the functions are compiled once for
+        # every model (a literal argument would compile a copy per value)
+        pm_ = np.int64(max(pooled, 0))
+        pooled_ = np.int64(pooled)
+        full_ = np.int64(FULL)
         Dv = stack2(ng, B)
         P = stack2(ng, B)
         Am = stack2(NA, B)
@@ -445,7 +423,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             if has_ref:
                 for l in range(ng):
                     gr[l] = g_ref[0, l]
-            block_norms(X, t0, p_s, gr, nrm_b, dn_b)
+            block_norms(X, t0, p_s, gr, nrm_b, dn_b, Gb)
             for j in range(B):
                 base_s[j] = ladder_base(dn_b[j])
                 low[j] = ladder_level(dn_b[j], base_s[j]) >> MAP_SHIFT
@@ -505,6 +483,9 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     code[j] |= c
                     for l in range(ng):
                         Dv[l, j] = gv[l]
+                if has_out:  # g(x_{i-1}), evaluated by the step's first stage
+                    for l in range(ng):
+                        g_out[i - 1, l] = Dv[l, 0]
                 k = i - 1
                 if i > measured and k % stride == 0:  # state k measured (once: not in a replay)
                     fifth = min(4, (5 * k) // nsteps)
@@ -512,15 +493,17 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                         windows_flush(meas, wmax, dmax, window, active, lo, cnt)
                         window = fifth
                     weight = 1.0 if k_last >= 0 else 0.0  # a pair with the state before
-                    norms(Dv, gr, gs, ds)
+                    difference_norms(Dv, gr, gs, ds)
                     if pooled >= 0:
-                        pairs_pooled(Dv, P, Am, weight)
+                        pairs_pooled(Dv, P, Am, weight, pm_)
                     elif ROWS_FULL > 1:
                         pairs_full(Dv, P, Am, weight)
-                    changed = levels(gs, ds, base_s, low, nlev, wmax, dmax)
+                    changed = block_levels(gs, ds, base_s, low, nlev, wmax, dmax)
                     if changed != 0:
-                        bin_flush(S_map, Am, nlev, low, changed, pooled)
-                    record(lt, lv, ds, nlev, k * tau)
+                        bin_flush(S_map, Am, nlev, low, changed, pooled_, full_)
+                    for j in range(B):  # time and norm on each slot's level (a scatter)
+                        lt[j, nlev[j]] = k * tau
+                        lv[j, nlev[j]] = ds[j]
                     k_last = k
                 measured = max(measured, i)
                 until_save -= 1
@@ -544,7 +527,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     renew = False
                 if until_save == 0:  # a stored sample, of the members whose steps succeeded
                     until_save = save_every
-                    block_norms(X, t0 + i * tau, p_s, gr, nrm_b, dn_b)
+                    block_norms(X, t0 + i * tau, p_s, gr, nrm_b, dn_b, Gb)
                     windows_flush(meas, wmax, dmax, window, active, lo, cnt)
                     for j in range(cnt):
                         if active[j]:
@@ -569,10 +552,13 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             if has_ref:
                 for l in range(ng):
                     gr[l] = g_ref[nsteps, l]
-            block_norms(X, tf, p_s, gr, nrm_b, dn_b)
+            block_norms(X, tf, p_s, gr, nrm_b, dn_b, Gb)
+            if has_out:
+                for l in range(ng):
+                    g_out[nsteps, l] = Gb[l, 0]
             windows_flush(meas, wmax, dmax, window, active, lo, cnt)
             if k_last >= 0:  # the sums of the bins not gone below
-                end_flush(S_map, Am, low, active, pooled)
+                end_flush(S_map, Am, low, active, pooled_, full_)
             for j in range(cnt):
                 final = math.nan
                 if active[j]:
@@ -593,7 +579,5 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                             meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape, pooled)
-    tag(key, block_norms, retire, stop_failed, block_failed, member_step, norms,
-        pairs_pooled, pairs_full, levels, record, bin_flush, end_flush, windows_flush)
-    return keyed_cache(soa_kernel, key), keyed_cache(reference_kernel,
-                                                     kernel_key(key, "reference"))
+    tag(key, block_norms, member_step)
+    return keyed_cache(soa_kernel, key)

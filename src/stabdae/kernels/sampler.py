@@ -62,35 +62,50 @@ def build_sampler(K):
     eps3 = np.finfo(np.float64).eps ** (1.0 / 3.0)
     eps = np.finfo(np.float64).eps
 
-    @njit(error_model="numpy")
-    def place(x_ref, t0, p, alpha, ws, G, GGt, r, y, xp, gp, gm, x):
-        """Place one member; returns its status."""
+    @njit(inline="always")
+    def place(x_start, t0, p, alpha, newton, ws, G, GGt, r, y, xp, gp, gpm, x):
+        """Place one member from ``x_start``; returns its status, with ``gp = g(x)`` at
+        the state ``x`` it leaves (without ``newton``: ``x_start`` itself, evaluated).
+        (The residual is called from three places only, the state's and the two
+        differences': each call is compiled inline, and two more were a tenth of a new
+        model's sampler compilation.)"""
         for l in range(N2):
-            x[l] = x_ref[l]
+            x[l] = x_start[l]
         amax = 0.0
-        for i in range(ng):
-            amax = max(amax, abs(alpha[i]))
-        for it in range(MAX_NEWTON + 1):
+        if newton:
+            for i in range(ng):
+                amax = max(amax, abs(alpha[i]))
+        stalled = False  # the last step was roundoff-limited
+        xnorm = 0.0
+        it = 0
+        while True:
             residual(t0, x, p, ws, gp)
+            if not newton:
+                return 0
             err = 0.0
             for i in range(ng):
                 r[i] = alpha[i] - gp[i]
                 err = max(err, abs(r[i]))
             if err <= SAMPLING_RTOL * amax:
                 return 0
+            if stalled:  # accept what evaluating g allows
+                if err <= SAMPLING_RTOL * amax + ROUNDOFF * eps * max(1.0, xnorm) ** 2:
+                    return 0
+                return _FAILED
             if it == MAX_NEWTON:
-                break
+                return _FAILED
+            it += 1
             # G = ∂g/∂x by central differences
             for l in range(N2):
                 h = eps3 * max(1.0, abs(x[l]))
                 for k in range(N2):
                     xp[k] = x[k]
                 xp[l] = x[l] + h
-                residual(t0, xp, p, ws, gp)
+                residual(t0, xp, p, ws, gpm[0])
                 xp[l] = x[l] - h
-                residual(t0, xp, p, ws, gm)
+                residual(t0, xp, p, ws, gpm[1])
                 for i in range(ng):
-                    G[i, l] = (gp[i] - gm[i]) / (2.0 * h)
+                    G[i, l] = (gpm[0, i] - gpm[1, i]) / (2.0 * h)
             for i in range(ng):
                 for k in range(i + 1):
                     s = 0.0
@@ -111,36 +126,33 @@ def build_sampler(K):
                 x[l] += s
                 step = max(step, abs(s))
                 xnorm = max(xnorm, abs(x[l]))
-            if step <= 4.0 * eps * max(1.0, xnorm):
-                # roundoff-limited: accept what evaluating g allows
-                residual(t0, x, p, ws, gp)
-                err = 0.0
-                for i in range(ng):
-                    err = max(err, abs(alpha[i] - gp[i]))
-                if err <= SAMPLING_RTOL * amax + ROUNDOFF * eps * max(1.0, xnorm) ** 2:
-                    return 0
-                return _FAILED
-        return _FAILED
+            stalled = step <= 4.0 * eps * max(1.0, xnorm)
 
     @njit(nogil=True, error_model="numpy")
-    def sample_kernel(x_ref, t0, p, alphas, x_out, alpha_out, status, c_lo, c_hi):
-        """Place the members of chunks ``c_lo … c_hi − 1`` (64 members each)."""
-        M = alphas.shape[0]
+    def sample_kernel(x_ref, t0, p, alphas, newton, x_out, alpha_out, status, c_lo, c_hi):
+        """Place the members of chunks ``c_lo … c_hi − 1`` (64 members each) from
+        ``x_ref`` at the targets ``alphas``; without ``newton``, only evaluate ``g`` at the
+        rows of ``x_out`` (``alphas`` not read: the residual rows of a model whose
+        sampler is compiled, without a kernel of their own)."""
+        M = x_out.shape[0]
         for c in range(c_lo, c_hi):
             ws = make_workspace()
-            G = np.empty((ng, N2))
-            GGt = np.empty((ng, ng))
+            nn = ng if newton else 0  # (the Newton steps' matrices: none to evaluate)
+            G = np.empty((nn, N2))
+            GGt = np.empty((nn, nn))
             r = np.empty(ng)
             y = np.empty(ng)
             xp = np.empty(N2)
             gp = np.empty(ng)
-            gm = np.empty(ng)
+            gpm = np.empty((2, ng))
             x = np.empty(N2)
             for j in range(c * CHUNK, min(M, (c + 1) * CHUNK)):
-                status[j] = place(x_ref, t0, p, alphas[j], ws, G, GGt, r, y, xp, gp, gm, x)
-                for l in range(N2):
-                    x_out[j, l] = x[l]
-                residual(t0, x, p, ws, gp)
+                x_start = x_ref if newton else x_out[j]
+                status[j] = place(x_start, t0, p, alphas[j], newton, ws, G, GGt, r, y, xp, gp,
+                                  gpm, x)  # fmt: skip
+                if newton:
+                    for l in range(N2):
+                        x_out[j, l] = x[l]
                 for i in range(ng):
                     alpha_out[j, i] = gp[i]
 

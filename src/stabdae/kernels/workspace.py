@@ -185,7 +185,7 @@ stack."""
 stack_int1.__doc__ = """An int64 array of compile-time length ``n`` on the stack."""
 
 
-@njit(forceinline=True)
+@njit(cache=True, forceinline=True)
 def copy_inputs(p, law_mat, law_scal, p_s, lm, ls):
     """Copy the ensemble kernels' small run-time inputs (parameters, the law's matrix and
     scalar) into the caller's stack arrays ``p_s``, ``lm``, ``ls``: the loops then read
@@ -198,7 +198,7 @@ def copy_inputs(p, law_mat, law_scal, p_s, lm, ls):
     ls[0] = law_scal[0]
 
 
-@njit(forceinline=True)
+@njit(cache=True, forceinline=True)
 def copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc):
     """Copy a scheme's run-time tableau into the caller's stack arrays (as
     :func:`copy_inputs`, for the same reason)."""
