@@ -321,10 +321,18 @@ def ensemble(
         if adaptive:
             x0, alpha0, status = _place(model, targets, p, t0, threads)
         else:
-            x0, alpha0, status, g_ref = _place(
-                model, targets, p, t0, threads,
-                beside=lambda: _reference_residuals(model, bound, scheme, p, t0, tau, nsteps,
-                                                    block, rdtype))  # fmt: skip
+            def reference():
+                return _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block,
+                                            rdtype)  # fmt: skip
+
+            # beside the placing only while the kernel is still to be compiled or loaded
+            # (its run alone is too short to pay for a thread)
+            if ensemble_kernel_for(model, bound, scheme, block).signatures:
+                x0, alpha0, status = _place(model, targets, p, t0, threads)
+                g_ref = reference()
+            else:
+                x0, alpha0, status, g_ref = _place(model, targets, p, t0, threads,
+                                                   beside=reference)  # fmt: skip
     else:
         alpha0 = _residual_rows(model, x0, p, t0, threads)
         status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))

@@ -835,26 +835,10 @@ def full_rows(ng: int) -> int:
 # the arguments, not from a closure: a closure per model was compiled on its own at each
 # new model's first ensemble (about a second in all).  Compiled once for every model
 # (cached) and inlined into the kernel, whose buffers have constant shapes.  (The
-# ladder's scatter is written in the kernel itself: optimized on its own first, over an
-# unknown block size, it lost its vectorization, a tenth of a pendulum's kernel time.)
-
-
-@njit(cache=True, forceinline=True, error_model="numpy")
-def difference_norms(Dv, gr, gn, dn):
-    """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
-    norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
-    ng, B = Dv.shape
-    for j in range(B):
-        gn[j] = 0.0
-        dn[j] = 0.0
-    for l in range(ng):
-        r = gr[l]
-        for j in range(B):
-            g = Dv[l, j]
-            d = g - r
-            Dv[l, j] = d
-            gn[j] = max(gn[j], abs(g))
-            dn[j] = max(dn[j], abs(d))
+# ladder's scatter is written in the kernel itself, and the full map's pairs and flushes
+# are closures, :func:`pairs_full_for` and :func:`flushes_for`: optimized on their own
+# over unknown sizes first, the scatter lost its vectorization and the copies their
+# unrolling, the pendulum's kernel 25 % and the double pendulum's 5 % slower.)
 
 
 @njit(cache=True, forceinline=True, error_model="numpy")
@@ -888,27 +872,52 @@ def pairs_pooled(Dv, P, A, w, pm):
             P[l, j] = Dv[l, j]
 
 
-@njit(cache=True, forceinline=True, error_model="numpy")
-def pairs_full(Dv, P, A, w):
-    """As :func:`pairs_pooled` for the full map (``A``: :func:`full_rows` rows): Σ p pᵀ
-    (upper triangle), Σ p' pᵀ, the count."""
-    ng, B = Dv.shape
-    c = 0
-    for r in range(ng):
-        for q in range(r, ng):
-            for j in range(B):
-                A[c, j] += w * (P[r, j] * P[q, j])
-            c += 1
-    for r in range(ng):
-        for q in range(ng):
-            for j in range(B):
-                A[c, j] += w * (Dv[r, j] * P[q, j])
-            c += 1
-    for j in range(B):
-        A[c, j] += w
-    for l in range(ng):
+def pairs_full_for(B: int, ng: int):
+    """As :func:`pairs_pooled` for the full map of ``ng`` components over blocks of ``B``
+    slots, ``pairs(Dv, P, A, w)`` (``A``: :func:`full_rows` rows): Σ p pᵀ (upper
+    triangle), Σ p' pᵀ, the count.  A closure over the sizes, compiled per kernel that
+    uses it: sized by its arrays and optimized on its own, its 2 ng² short loops each
+    checked their arrays for overlap at run time (the double pendulum's RK4 ensemble 5 %
+    slower)."""
+
+    @njit(forceinline=True, error_model="numpy")
+    def pairs_full(Dv, P, A, w):
+        c = 0
+        for r in range(ng):
+            for q in range(r, ng):
+                for j in range(B):
+                    A[c, j] += w * (P[r, j] * P[q, j])
+                c += 1
+        for r in range(ng):
+            for q in range(ng):
+                for j in range(B):
+                    A[c, j] += w * (Dv[r, j] * P[q, j])
+                c += 1
         for j in range(B):
-            P[l, j] = Dv[l, j]
+            A[c, j] += w
+        for l in range(ng):
+            for j in range(B):
+                P[l, j] = Dv[l, j]
+
+    return pairs_full
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def difference_norms(Dv, gr, gn, dn):
+    """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
+    norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
+    ng, B = Dv.shape
+    for j in range(B):
+        gn[j] = 0.0
+        dn[j] = 0.0
+    for l in range(ng):
+        r = gr[l]
+        for j in range(B):
+            g = Dv[l, j]
+            d = g - r
+            Dv[l, j] = d
+            gn[j] = max(gn[j], abs(g))
+            dn[j] = max(dn[j], abs(d))
 
 
 @njit(cache=True, forceinline=True, error_model="numpy")
@@ -935,56 +944,103 @@ def block_levels(gn, dn, base, low, nlev, wmax, dmax):
 
 
 @njit(cache=True, forceinline=True)
-def _store(S, A, j, bin_, pooled, full):
-    """Slot ``j``'s sums so far as those of its bin ``bin_`` (``pooled ≥ 0``: the pooled
-    map's; else the full map's of ``full`` components, none when 0)."""
-    if pooled >= 0:
-        S[j, bin_, 0] = A[0, j]
-        S[j, bin_, 1] = A[1, j]
-        S[j, bin_, 2] = A[1, j]
-        S[j, bin_, 3] = A[2, j]
-        for c in range(4):
-            S[j, bin_, 4 + c] = A[3 + c, j]
-        S[j, bin_, 8] = A[7, j]
-        S[j, bin_, 9] = A[8, j]
-        S[j, bin_, 10] = A[9, j]
-    elif full:
-        c = 0
-        for r in range(full):
-            for q in range(r, full):
-                S[j, bin_, r * full + q] = A[c, j]
-                if q != r:
-                    S[j, bin_, q * full + r] = A[c, j]
-                c += 1
-        for r in range(full * full):
-            S[j, bin_, full * full + r] = A[c, j]
-            c += 1
-        S[j, bin_, 2 * full * full] = A[c, j]
+def _store_pooled(S, A, j, bin_):
+    """Slot ``j``'s pooled sums so far as those of its bin ``bin_``."""
+    S[j, bin_, 0] = A[0, j]
+    S[j, bin_, 1] = A[1, j]
+    S[j, bin_, 2] = A[1, j]
+    S[j, bin_, 3] = A[2, j]
+    for c in range(4):
+        S[j, bin_, 4 + c] = A[3 + c, j]
+    S[j, bin_, 8] = A[7, j]
+    S[j, bin_, 9] = A[8, j]
+    S[j, bin_, 10] = A[9, j]
 
 
 @njit(cache=True, error_model="numpy")
-def bin_flush(S, A, nlev, low, mask, pooled, full):
-    """The slots of the set bits of ``mask``, whose level went below the lowest bin they
-    had reached: their sums so far (the pair just added, from a state above, included)
-    become those of each bin passed, down to the new one's, which is then the lowest
-    (``pooled``, ``full``: :func:`_store`)."""
+def _bin_flush_pooled(S, A, nlev, low, mask, pooled):
+    """:func:`flushes_for`'s ``bin_flush`` for the pooled map (or none, ``pooled < 0``)."""
     while mask != 0:
         j = trailing_zeros(mask)
         mask &= mask - 1
         nb = nlev[j] >> MAP_SHIFT
-        for b in range(nb + 1, low[j] + 1):
-            _store(S, A, j, b, pooled, full)
+        if pooled >= 0:
+            for b in range(nb + 1, low[j] + 1):
+                _store_pooled(S, A, j, b)
         low[j] = nb
 
 
 @njit(cache=True, error_model="numpy")
-def end_flush(S, A, low, active, pooled, full):
-    """At the end of the run: each running slot's sums as those of the bins it did not go
-    below."""
-    for j in range(low.shape[0]):
-        if active[j]:
-            for b in range(low[j] + 1):
-                _store(S, A, j, b, pooled, full)
+def _end_flush_pooled(S, A, low, active, pooled):
+    """:func:`flushes_for`'s ``end_flush`` for the pooled map (or none)."""
+    if pooled >= 0:
+        for j in range(low.shape[0]):
+            if active[j]:
+                for b in range(low[j] + 1):
+                    _store_pooled(S, A, j, b)
+
+
+def flushes_for(FULL: int):
+    """``(bin_flush, end_flush)`` for the full map of ``FULL`` components: closures over it,
+    compiled per kernel, since a copy of a slot's sums sized at run time made the double
+    pendulum's RK4 ensemble (full map, a flush at every bin a member's level crosses) 5 %
+    slower than the unrolled one.  For ``FULL = 0`` (the pooled map, or none) the
+    functions compiled once for every model (cached; ``pooled`` then a run-time int64).
+
+    ``bin_flush(S, A, nlev, low, mask, pooled)``: the slots of the set bits of ``mask``,
+    whose level went below the lowest bin they had reached: their sums so far (the pair
+    just added, from a state above, included) become those of each bin passed, down to
+    the new one's, which is then the lowest.
+
+    ``end_flush(S, A, low, active, pooled)``: at the end of the run, each running slot's
+    sums as those of the bins it did not go below."""
+    if not FULL:
+        return _bin_flush_pooled, _end_flush_pooled
+
+    @njit(forceinline=True)
+    def _store(S, A, j, bin_, pooled):
+        """Slot ``j``'s sums so far as those of its bin ``bin_``."""
+        if pooled >= 0:
+            S[j, bin_, 0] = A[0, j]
+            S[j, bin_, 1] = A[1, j]
+            S[j, bin_, 2] = A[1, j]
+            S[j, bin_, 3] = A[2, j]
+            for c in range(4):
+                S[j, bin_, 4 + c] = A[3 + c, j]
+            S[j, bin_, 8] = A[7, j]
+            S[j, bin_, 9] = A[8, j]
+            S[j, bin_, 10] = A[9, j]
+        elif FULL:
+            c = 0
+            for r in range(FULL):
+                for q in range(r, FULL):
+                    S[j, bin_, r * FULL + q] = A[c, j]
+                    if q != r:
+                        S[j, bin_, q * FULL + r] = A[c, j]
+                    c += 1
+            for r in range(FULL * FULL):
+                S[j, bin_, FULL * FULL + r] = A[c, j]
+                c += 1
+            S[j, bin_, 2 * FULL * FULL] = A[c, j]
+
+    @njit(error_model="numpy")
+    def bin_flush(S, A, nlev, low, mask, pooled):
+        while mask != 0:
+            j = trailing_zeros(mask)
+            mask &= mask - 1
+            nb = nlev[j] >> MAP_SHIFT
+            for b in range(nb + 1, low[j] + 1):
+                _store(S, A, j, b, pooled)
+            low[j] = nb
+
+    @njit(error_model="numpy")
+    def end_flush(S, A, low, active, pooled):
+        for j in range(low.shape[0]):
+            if active[j]:
+                for b in range(low[j] + 1):
+                    _store(S, A, j, b, pooled)
+
+    return bin_flush, end_flush
 
 
 @njit(cache=True, error_model="numpy")

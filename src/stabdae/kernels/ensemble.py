@@ -60,11 +60,10 @@ from .decay import (
     MAP_MAX_NG,
     MAP_SHIFT,
     begin,
-    bin_flush,
     block_levels,
     difference_norms,
-    end_flush,
     finish_with_map,
+    flushes_for,
     full_rows,
     ladder_base,
     ladder_level,
@@ -72,7 +71,7 @@ from .decay import (
     map_begin,
     map_buffers,
     observe,
-    pairs_full,
+    pairs_full_for,
     pairs_pooled,
     predict,
     scratch,
@@ -303,6 +302,8 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     stack_workspace = K.stack_workspace
     ROWS_FULL = full_rows(ng)
     FULL = ng if ng <= MAP_MAX_NG else 0  # the full map's components (none: 0)
+    pairs_full = pairs_full_for(B, FULL)
+    bin_flush, end_flush = flushes_for(FULL)
     NA = 10 if pooled >= 0 else ROWS_FULL  # rows of the current bin visit's sums
 
     @njit(error_model="numpy")
@@ -387,11 +388,10 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         # map's bins it reached and its level at this state; the largest norms of the
         # fifth.
         S_map = map_buffers(B, ng, pooled)
-        # the measurement's sizes as run-time integers: the functions are compiled once for
-        # every model (a literal argument would compile a copy per value)
+        # (as run-time integers: pairs_pooled and the pooled flushes are compiled once for
+        # every model, and a literal argument would compile a copy per value)
         pm_ = np.int64(max(pooled, 0))
         pooled_ = np.int64(pooled)
-        full_ = np.int64(FULL)
         Dv = stack2(ng, B)
         P = stack2(ng, B)
         Am = stack2(NA, B)
@@ -500,7 +500,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                         pairs_full(Dv, P, Am, weight)
                     changed = block_levels(gs, ds, base_s, low, nlev, wmax, dmax)
                     if changed != 0:
-                        bin_flush(S_map, Am, nlev, low, changed, pooled_, full_)
+                        bin_flush(S_map, Am, nlev, low, changed, pooled_)
                     for j in range(B):  # time and norm on each slot's level (a scatter)
                         lt[j, nlev[j]] = k * tau
                         lv[j, nlev[j]] = ds[j]
@@ -558,7 +558,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     g_out[nsteps, l] = Gb[l, 0]
             windows_flush(meas, wmax, dmax, window, active, lo, cnt)
             if k_last >= 0:  # the sums of the bins not gone below
-                end_flush(S_map, Am, low, active, pooled_, full_)
+                end_flush(S_map, Am, low, active, pooled_)
             for j in range(cnt):
                 final = math.nan
                 if active[j]:
@@ -579,5 +579,6 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                             meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape, pooled)
-    tag(key, block_norms, member_step)
+    tag(key, block_norms, member_step, pairs_full,
+        *((bin_flush, end_flush) if FULL else ()))  # (closures only)
     return keyed_cache(soa_kernel, key)
