@@ -592,7 +592,6 @@ def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
     one decaying with rises and one that jumps several bins at once, against the sums
     taken pair by pair."""
     B, ng = 2, 2
-    bin_flush, end_flush = decay.flushes_for(0)
 
     @njit
     def run(G):  # G[k, l, j]: the residual of member j at measured state k
@@ -613,11 +612,11 @@ def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
             decay.pairs_pooled(Dv, P, A, 1.0 if k > 0 else 0.0, 1)
             changed = decay.block_levels(gn, dn, base, low, nlev, wmax, dmax)
             if changed != 0:
-                bin_flush(S, A, nlev, low, changed, 1)
+                decay.bin_flush(S, A, nlev, low, changed, 1, 0)
             for j in range(B):
                 lt[j, nlev[j]] = float(k)
                 lv[j, nlev[j]] = dn[j]
-        end_flush(S, A, low, active, 1)
+        decay.end_flush(S, A, low, active, 1, 0)
         return S, base
 
     rng = np.random.default_rng(2)

@@ -842,6 +842,24 @@ def full_rows(ng: int) -> int:
 
 
 @njit(cache=True, forceinline=True, error_model="numpy")
+def difference_norms(Dv, gr, gn, dn):
+    """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
+    norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
+    ng, B = Dv.shape
+    for j in range(B):
+        gn[j] = 0.0
+        dn[j] = 0.0
+    for l in range(ng):
+        r = gr[l]
+        for j in range(B):
+            g = Dv[l, j]
+            d = g - r
+            Dv[l, j] = d
+            gn[j] = max(gn[j], abs(g))
+            dn[j] = max(dn[j], abs(d))
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
 def pairs_pooled(Dv, P, A, w, pm):
     """The pairs (``P``: the previous measured residuals, ``Dv``: the current; their first
     ``2 pm`` rows ``(f, ḟ)``, ``pm`` the holonomic constraints) added with weight ``w`` (0:
@@ -870,6 +888,101 @@ def pairs_pooled(Dv, P, A, w, pm):
     for l in range(ng):
         for j in range(B):
             P[l, j] = Dv[l, j]
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def block_levels(gn, dn, base, low, nlev, wmax, dmax):
+    """The block's norms ``gn`` (of ``g``) and ``dn`` (measured) at a state: the largest of
+    the fifth, each slot's ladder level into ``nlev`` (``NBINS``, the ladder's spare
+    column, for a non-finite norm, which :func:`observe` leaves out); returns a mask of
+    the slots whose level went below ``low``, the lowest of the map's bins they had
+    reached (at most 64 slots)."""
+    changed = 0
+    for j in range(gn.shape[0]):
+        v = gn[j]
+        wm = wmax[j]
+        wmax[j] = v if (v < math.inf and not (wm >= v)) else wm
+        d = dn[j]
+        ok = d < math.inf
+        dm = dmax[j]
+        dmax[j] = d if (ok and not (dm >= d)) else dm
+        b = ladder_level(d, base[j])
+        nlev[j] = b if ok else NBINS
+        lower = ok and (b >> MAP_SHIFT) < low[j]
+        changed |= (1 if lower else 0) << j
+    return changed
+
+
+@njit(cache=True, forceinline=True)
+def _store(S, A, j, bin_, pooled, full):
+    """Slot ``j``'s sums so far as those of its bin ``bin_`` (``pooled ≥ 0``: the pooled
+    map's; else the full map's of ``full`` components, none when 0)."""
+    if pooled >= 0:
+        S[j, bin_, 0] = A[0, j]
+        S[j, bin_, 1] = A[1, j]
+        S[j, bin_, 2] = A[1, j]
+        S[j, bin_, 3] = A[2, j]
+        for c in range(4):
+            S[j, bin_, 4 + c] = A[3 + c, j]
+        S[j, bin_, 8] = A[7, j]
+        S[j, bin_, 9] = A[8, j]
+        S[j, bin_, 10] = A[9, j]
+    elif full:
+        c = 0
+        for r in range(full):
+            for q in range(r, full):
+                S[j, bin_, r * full + q] = A[c, j]
+                if q != r:
+                    S[j, bin_, q * full + r] = A[c, j]
+                c += 1
+        for r in range(full * full):
+            S[j, bin_, full * full + r] = A[c, j]
+            c += 1
+        S[j, bin_, 2 * full * full] = A[c, j]
+
+
+@njit(cache=True, error_model="numpy")
+def bin_flush(S, A, nlev, low, mask, pooled, full):
+    """The slots of the set bits of ``mask``, whose level went below the lowest bin they
+    had reached: their sums so far (the pair just added, from a state above, included)
+    become those of each bin passed, down to the new one's, which is then the lowest
+    (``pooled``, ``full``: :func:`_store`)."""
+    while mask != 0:
+        j = trailing_zeros(mask)
+        mask &= mask - 1
+        nb = nlev[j] >> MAP_SHIFT
+        for b in range(nb + 1, low[j] + 1):
+            _store(S, A, j, b, pooled, full)
+        low[j] = nb
+
+
+@njit(cache=True, error_model="numpy")
+def end_flush(S, A, low, active, pooled, full):
+    """At the end of the run: each running slot's sums as those of the bins it did not go
+    below."""
+    for j in range(low.shape[0]):
+        if active[j]:
+            for b in range(low[j] + 1):
+                _store(S, A, j, b, pooled, full)
+
+
+@njit(cache=True, error_model="numpy")
+def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
+    """The largest norms of fifth ``window`` so far to the rows of the running members;
+    then cleared."""
+    for j in range(cnt):
+        if active[j]:
+            row = lo + j
+            c = C_W0 + window
+            if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
+                meas[row, c] = wmax[j]
+            if window >= 2:
+                c = C_D2 + window - 2
+                if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
+                    meas[row, c] = dmax[j]
+    for j in range(wmax.shape[0]):
+        wmax[j] = -math.inf
+        dmax[j] = -math.inf
 
 
 def pairs_full_for(B: int, ng: int):
@@ -902,164 +1015,48 @@ def pairs_full_for(B: int, ng: int):
     return pairs_full
 
 
-@njit(cache=True, forceinline=True, error_model="numpy")
-def difference_norms(Dv, gr, gn, dn):
-    """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
-    norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
-    ng, B = Dv.shape
-    for j in range(B):
-        gn[j] = 0.0
-        dn[j] = 0.0
-    for l in range(ng):
-        r = gr[l]
-        for j in range(B):
-            g = Dv[l, j]
-            d = g - r
-            Dv[l, j] = d
-            gn[j] = max(gn[j], abs(g))
-            dn[j] = max(dn[j], abs(d))
-
-
-@njit(cache=True, forceinline=True, error_model="numpy")
-def block_levels(gn, dn, base, low, nlev, wmax, dmax):
-    """The block's norms ``gn`` (of ``g``) and ``dn`` (measured) at a state: the largest of
-    the fifth, each slot's ladder level into ``nlev`` (``NBINS``, the ladder's spare
-    column, for a non-finite norm, which :func:`observe` leaves out); returns a mask of
-    the slots whose level went below ``low``, the lowest of the map's bins they had
-    reached (at most 64 slots)."""
-    changed = 0
-    for j in range(gn.shape[0]):
-        v = gn[j]
-        wm = wmax[j]
-        wmax[j] = v if (v < math.inf and not (wm >= v)) else wm
-        d = dn[j]
-        ok = d < math.inf
-        dm = dmax[j]
-        dmax[j] = d if (ok and not (dm >= d)) else dm
-        b = ladder_level(d, base[j])
-        nlev[j] = b if ok else NBINS
-        lower = ok and (b >> MAP_SHIFT) < low[j]
-        changed |= (1 if lower else 0) << j
-    return changed
-
-
-@njit(cache=True, forceinline=True)
-def _store_pooled(S, A, j, bin_):
-    """Slot ``j``'s pooled sums so far as those of its bin ``bin_``."""
-    S[j, bin_, 0] = A[0, j]
-    S[j, bin_, 1] = A[1, j]
-    S[j, bin_, 2] = A[1, j]
-    S[j, bin_, 3] = A[2, j]
-    for c in range(4):
-        S[j, bin_, 4 + c] = A[3 + c, j]
-    S[j, bin_, 8] = A[7, j]
-    S[j, bin_, 9] = A[8, j]
-    S[j, bin_, 10] = A[9, j]
-
-
-@njit(cache=True, error_model="numpy")
-def _bin_flush_pooled(S, A, nlev, low, mask, pooled):
-    """:func:`flushes_for`'s ``bin_flush`` for the pooled map (or none, ``pooled < 0``)."""
-    while mask != 0:
-        j = trailing_zeros(mask)
-        mask &= mask - 1
-        nb = nlev[j] >> MAP_SHIFT
-        if pooled >= 0:
-            for b in range(nb + 1, low[j] + 1):
-                _store_pooled(S, A, j, b)
-        low[j] = nb
-
-
-@njit(cache=True, error_model="numpy")
-def _end_flush_pooled(S, A, low, active, pooled):
-    """:func:`flushes_for`'s ``end_flush`` for the pooled map (or none)."""
-    if pooled >= 0:
-        for j in range(low.shape[0]):
-            if active[j]:
-                for b in range(low[j] + 1):
-                    _store_pooled(S, A, j, b)
-
-
 def flushes_for(FULL: int):
-    """``(bin_flush, end_flush)`` for the full map of ``FULL`` components: closures over it,
-    compiled per kernel, since a copy of a slot's sums sized at run time made the double
-    pendulum's RK4 ensemble (full map, a flush at every bin a member's level crosses) 5 %
-    slower than the unrolled one.  For ``FULL = 0`` (the pooled map, or none) the
-    functions compiled once for every model (cached; ``pooled`` then a run-time int64).
-
-    ``bin_flush(S, A, nlev, low, mask, pooled)``: the slots of the set bits of ``mask``,
-    whose level went below the lowest bin they had reached: their sums so far (the pair
-    just added, from a state above, included) become those of each bin passed, down to
-    the new one's, which is then the lowest.
-
-    ``end_flush(S, A, low, active, pooled)``: at the end of the run, each running slot's
-    sums as those of the bins it did not go below."""
+    """``(bin_flush, end_flush)`` for a kernel whose one-step map is the full one of
+    ``FULL`` components: closures over it (the full map's copy of a slot's sums, sized
+    at run time in :func:`bin_flush`, made the double pendulum's RK4 ensemble with a
+    full law matrix 5 % slower than this unrolled one).  For ``FULL = 0`` (the pooled
+    map, or none) :func:`bin_flush` and :func:`end_flush` themselves, compiled once for
+    every model.  Both take ``(…, pooled, full)`` as those do."""
     if not FULL:
-        return _bin_flush_pooled, _end_flush_pooled
+        return bin_flush, end_flush
 
     @njit(forceinline=True)
-    def _store(S, A, j, bin_, pooled):
-        """Slot ``j``'s sums so far as those of its bin ``bin_``."""
-        if pooled >= 0:
-            S[j, bin_, 0] = A[0, j]
-            S[j, bin_, 1] = A[1, j]
-            S[j, bin_, 2] = A[1, j]
-            S[j, bin_, 3] = A[2, j]
-            for c in range(4):
-                S[j, bin_, 4 + c] = A[3 + c, j]
-            S[j, bin_, 8] = A[7, j]
-            S[j, bin_, 9] = A[8, j]
-            S[j, bin_, 10] = A[9, j]
-        elif FULL:
-            c = 0
-            for r in range(FULL):
-                for q in range(r, FULL):
-                    S[j, bin_, r * FULL + q] = A[c, j]
-                    if q != r:
-                        S[j, bin_, q * FULL + r] = A[c, j]
-                    c += 1
-            for r in range(FULL * FULL):
-                S[j, bin_, FULL * FULL + r] = A[c, j]
+    def _store_full(S, A, j, bin_):
+        c = 0
+        for r in range(FULL):
+            for q in range(r, FULL):
+                S[j, bin_, r * FULL + q] = A[c, j]
+                if q != r:
+                    S[j, bin_, q * FULL + r] = A[c, j]
                 c += 1
-            S[j, bin_, 2 * FULL * FULL] = A[c, j]
+        for r in range(FULL * FULL):
+            S[j, bin_, FULL * FULL + r] = A[c, j]
+            c += 1
+        S[j, bin_, 2 * FULL * FULL] = A[c, j]
 
     @njit(error_model="numpy")
-    def bin_flush(S, A, nlev, low, mask, pooled):
+    def bin_flush_full(S, A, nlev, low, mask, pooled, full):
         while mask != 0:
             j = trailing_zeros(mask)
             mask &= mask - 1
             nb = nlev[j] >> MAP_SHIFT
             for b in range(nb + 1, low[j] + 1):
-                _store(S, A, j, b, pooled)
+                _store_full(S, A, j, b)
             low[j] = nb
 
     @njit(error_model="numpy")
-    def end_flush(S, A, low, active, pooled):
+    def end_flush_full(S, A, low, active, pooled, full):
         for j in range(low.shape[0]):
             if active[j]:
                 for b in range(low[j] + 1):
-                    _store(S, A, j, b, pooled)
+                    _store_full(S, A, j, b)
 
-    return bin_flush, end_flush
-
-
-@njit(cache=True, error_model="numpy")
-def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
-    """The largest norms of fifth ``window`` so far to the rows of the running members;
-    then cleared."""
-    for j in range(cnt):
-        if active[j]:
-            row = lo + j
-            c = C_W0 + window
-            if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
-                meas[row, c] = wmax[j]
-            if window >= 2:
-                c = C_D2 + window - 2
-                if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
-                    meas[row, c] = dmax[j]
-    for j in range(wmax.shape[0]):
-        wmax[j] = -math.inf
-        dmax[j] = -math.inf
+    return bin_flush_full, end_flush_full
 
 
 @njit(cache=True)

@@ -303,7 +303,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
     ROWS_FULL = full_rows(ng)
     FULL = ng if ng <= MAP_MAX_NG else 0  # the full map's components (none: 0)
     pairs_full = pairs_full_for(B, FULL)
-    bin_flush, end_flush = flushes_for(FULL)
+    bin_flush, end_flush = flushes_for(FULL if pooled < 0 else 0)
     NA = 10 if pooled >= 0 else ROWS_FULL  # rows of the current bin visit's sums
 
     @njit(error_model="numpy")
@@ -388,10 +388,11 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
         # map's bins it reached and its level at this state; the largest norms of the
         # fifth.
         S_map = map_buffers(B, ng, pooled)
-        # (as run-time integers: pairs_pooled and the pooled flushes are compiled once for
-        # every model, and a literal argument would compile a copy per value)
+        # (as run-time integers: pairs_pooled and the pooled map's flushes are compiled once
+        # for every model, and a literal argument would compile a copy per value)
         pm_ = np.int64(max(pooled, 0))
         pooled_ = np.int64(pooled)
+        full_ = np.int64(FULL)
         Dv = stack2(ng, B)
         P = stack2(ng, B)
         Am = stack2(NA, B)
@@ -500,7 +501,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                         pairs_full(Dv, P, Am, weight)
                     changed = block_levels(gs, ds, base_s, low, nlev, wmax, dmax)
                     if changed != 0:
-                        bin_flush(S_map, Am, nlev, low, changed, pooled_)
+                        bin_flush(S_map, Am, nlev, low, changed, pooled_, full_)
                     for j in range(B):  # time and norm on each slot's level (a scatter)
                         lt[j, nlev[j]] = k * tau
                         lv[j, nlev[j]] = ds[j]
@@ -558,7 +559,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     g_out[nsteps, l] = Gb[l, 0]
             windows_flush(meas, wmax, dmax, window, active, lo, cnt)
             if k_last >= 0:  # the sums of the bins not gone below
-                end_flush(S_map, Am, low, active, pooled_)
+                end_flush(S_map, Am, low, active, pooled_, full_)
             for j in range(cnt):
                 final = math.nan
                 if active[j]:
@@ -580,5 +581,5 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
 
     key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape, pooled)
     tag(key, block_norms, member_step, pairs_full,
-        *((bin_flush, end_flush) if FULL else ()))  # (closures only)
+        *((bin_flush, end_flush) if FULL and pooled < 0 else ()))  # (closures only)
     return keyed_cache(soa_kernel, key)

@@ -1,0 +1,114 @@
+"""The first ensemble of a model: seconds from calling ``stabdae.ensemble`` in a new process
+with an empty kernel cache to its dataset, and where they go (numba's ``numba:compile`` and
+``numba:llvm_lock`` events: each kernel's compilation, and LLVM's part of it).
+
+Every run is a new process with a new kernel cache (``STABDAE_CACHE_DIR``); the library's
+own functions are in numba's cache already (one run per source tree first, not counted),
+as after any first use.  With ``--baseline REV`` the same runs of that git revision (a
+worktree) alternate with this tree's, so that both see the same machine::
+
+    python studies/bench_first_ensemble.py --scenes fekete pendulum --repeat 3 --baseline HEAD
+
+The ensemble: 4096 members, radius (1e-6, 1e-3), midpoint, Baumgarte ω = 10, ξ = 1, over
+1 s, τ = 0.01 for Fekete's charges and 1e-3 otherwise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+MEMBERS = 4096
+
+CHILD = r"""
+import json, sys, time
+from numba.core import event
+import stabdae
+
+class Events(event.Listener):
+    def __init__(self):
+        self.llvm, self.held, self.depth, self.rows = 0.0, None, [], []
+    def on_start(self, ev):
+        if ev.kind == "numba:llvm_lock":
+            self.held = time.perf_counter()
+        elif ev.kind == "numba:compile":
+            self.depth.append((ev.data["dispatcher"], time.perf_counter(), self.llvm))
+    def on_end(self, ev):
+        if ev.kind == "numba:llvm_lock":
+            self.llvm += time.perf_counter() - self.held
+        elif ev.kind == "numba:compile":
+            d, t0, l0 = self.depth.pop()
+            if not self.depth:  # a kernel (what it compiles inside it included)
+                name = getattr(d, "__qualname__", str(d)).split("<locals>.")[-1]
+                self.rows.append((name, time.perf_counter() - t0, self.llvm - l0))
+
+ev = Events()
+event.register("numba:llvm_lock", ev)
+event.register("numba:compile", ev)
+scene, members = sys.argv[1], int(sys.argv[2])
+model = stabdae.load_model(scene)
+tau = 0.01 if scene == "fekete" else 1e-3
+clock = time.perf_counter()
+ds = stabdae.ensemble(model, stabdae.baumgarte(10.0, 1.0), "midpoint", tau, 1.0,
+                      members=members, radius=(1e-6, 1e-3), seed=1)
+first = time.perf_counter() - clock
+print(json.dumps(dict(first=first, llvm=ev.llvm, kernels=ev.rows,
+                      integrate=ds.attrs["wall_integrate_s"])))
+"""
+
+
+def run(src: Path, scene: str, members: int) -> dict:
+    """One first ensemble of ``scene`` with the library at ``src``, a fresh kernel cache."""
+    with tempfile.TemporaryDirectory(prefix="stabdae-first-") as cache:
+        env = dict(os.environ, PYTHONPATH=str(src), STABDAE_CACHE_DIR=cache)
+        out = subprocess.run([sys.executable, "-c", CHILD, scene, str(members)], env=env,
+                             check=True, capture_output=True, text=True)  # fmt: skip
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenes", nargs="+", default=["fekete", "pendulum"])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--members", type=int, default=MEMBERS)
+    ap.add_argument("--baseline", metavar="REV", help="also run this git revision (a worktree)")
+    args = ap.parse_args(argv)
+
+    trees = {"this tree": HERE.parent / "src"}
+    work = None
+    if args.baseline:
+        work = Path(tempfile.mkdtemp(prefix="stabdae-first-base-")) / "tree"
+        subprocess.run(["git", "-C", str(HERE.parent), "worktree", "add", "--detach", str(work),
+                        args.baseline], check=True, capture_output=True)  # fmt: skip
+        rev = subprocess.run(["git", "-C", str(work), "rev-parse", "--short", "HEAD"],
+                             check=True, capture_output=True, text=True).stdout.strip()  # fmt: skip
+        trees[f"at {rev}"] = work / "src"
+    try:
+        for src in trees.values():  # the library's own functions into numba's cache
+            run(src, args.scenes[0], 64)
+        for scene in args.scenes:
+            print(f"\n{scene}: first ensemble, {args.members} members (s)")
+            best = {}
+            for _ in range(args.repeat):
+                for label, src in trees.items():
+                    res = run(src, scene, args.members)
+                    kernels = ", ".join(f"{n} {s:.2f} (LLVM {ll:.2f})"
+                                        for n, s, ll in res["kernels"] if s >= 0.1)  # fmt: skip
+                    print(f"  {label:>14}: {res['first']:6.2f}  integration "
+                          f"{res['integrate']:.2f}, LLVM {res['llvm']:.2f}; {kernels}")
+                    best[label] = min(best.get(label, float("inf")), res["first"])
+            print("  best: " + ", ".join(f"{k} {v:.2f}" for k, v in best.items()))
+    finally:
+        if work is not None:
+            subprocess.run(["git", "-C", str(HERE.parent), "worktree", "remove", "--force",
+                            str(work)], check=False, capture_output=True)  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()
