@@ -144,7 +144,7 @@ def _residual_rows(model, x, p, t0, threads=None, sampler=False):
     out = np.empty((x.shape[0], model.n_residual))
     if sampler:
         kernel = sampler_for(model)
-        x = np.array(x, dtype=float, order="C")  # (rows evaluated in place)
+        x = np.ascontiguousarray(x, dtype=float)  # (only read: the sampler writes no state)
         none = np.empty((x.shape[0], 0))
         status = np.empty(x.shape[0], dtype=np.int8)
         unused = np.zeros(x.shape[1])  # (the state placing starts from)
