@@ -42,6 +42,7 @@ import numpy as np
 from numba import njit
 
 import stabdae
+from stabdae import simdmath
 
 # p = [m1, m2, m3, m4, m5, m6, m7, xa, ya, xb, yb, xc, yc, c0, i1, i2, i3, i4, i5, i6, i7, d, da,
 #     e, ea, rr, ra, l0, ss, sa, sb, sc, sd, ta, tb, u, ua, ub, zf, zt, fa, mom]
@@ -80,18 +81,18 @@ def mass(t, q, p, out):
     zf = p[38]
     zt = p[39]
     fa = p[40]
-    e0 = da * m2 * rr * math.cos(Theta)
+    e0 = da * m2 * rr * simdmath.cos(Theta)
     e1 = (da * da) * m2 + i2
     e2 = e * m4
     e3 = 2.0 * ea
     e4 = (e * e) * m4 - e2 * e3 + (ea * ea) * m4 + i4
-    e5 = zt * math.sin(Phi)
+    e5 = zt * simdmath.sin(Phi)
     e6 = e2 * e5
     e7 = e5 * m4
     e8 = fa * m6
     e9 = 2.0 * zf
     e10 = -e8 * e9 + (fa * fa) * m6 + i6 + m6 * (zf * zf)
-    e11 = u * math.sin(Omega)
+    e11 = u * simdmath.sin(Omega)
     e12 = e11 * e8
     e13 = e11 * m6
     out[:, :] = 0.0
@@ -140,10 +141,10 @@ def forces(t, q, v, p, out):
     zt = p[39]
     fa = p[40]
     mom = p[41]
-    e0 = da * m2 * rr * math.sin(Theta)
-    e1 = math.cos(gamma)
+    e0 = da * m2 * rr * simdmath.sin(Theta)
+    e1 = simdmath.cos(gamma)
     e2 = c0 * sc
-    e3 = math.sin(gamma)
+    e3 = simdmath.sin(gamma)
     e4 = e2 * e3
     e5 = c0 * sd
     e6 = e3 * e5
@@ -169,12 +170,12 @@ def forces(t, q, v, p, out):
     )
     e20 = e19 * l0
     e21 = (delta_dot * delta_dot)
-    e22 = math.cos(Phi)
+    e22 = simdmath.cos(Phi)
     e23 = e22 * m4 * zt
     e24 = (Phi_dot * Phi_dot) * e23
     e25 = 2.0 * Phi_dot * delta_dot * e23
     e26 = (epsilon_dot * epsilon_dot)
-    e27 = math.cos(Omega)
+    e27 = simdmath.cos(Omega)
     e28 = e27 * m6 * u
     e29 = (Omega_dot * Omega_dot) * e28
     e30 = 2.0 * Omega_dot * e28 * epsilon_dot
@@ -207,18 +208,18 @@ def f(t, q, p, out):
     zf = p[38]
     zt = p[39]
     e0 = Theta + beta
-    e1 = d * math.cos(e0) - rr * math.cos(beta)
-    e2 = d * math.sin(e0) - rr * math.sin(beta)
+    e1 = d * simdmath.cos(e0) - rr * simdmath.cos(beta)
+    e2 = d * simdmath.sin(e0) - rr * simdmath.sin(beta)
     e3 = Phi + delta
     e4 = e1 + xa
     e5 = e2 + ya
     e6 = Omega + epsilon
-    out[0] = -e1 - ss * math.sin(gamma) - xb
-    out[1] = -e2 + ss * math.cos(gamma) - yb
-    out[2] = -e * math.sin(e3) - e4 - zt * math.cos(delta)
-    out[3] = e * math.cos(e3) - e5 - zt * math.sin(delta)
-    out[4] = -e4 - u * math.sin(epsilon) - zf * math.cos(e6)
-    out[5] = -e5 + u * math.cos(epsilon) - zf * math.sin(e6)
+    out[0] = -e1 - ss * simdmath.sin(gamma) - xb
+    out[1] = -e2 + ss * simdmath.cos(gamma) - yb
+    out[2] = -e * simdmath.sin(e3) - e4 - zt * simdmath.cos(delta)
+    out[3] = e * simdmath.cos(e3) - e5 - zt * simdmath.sin(delta)
+    out[4] = -e4 - u * simdmath.sin(epsilon) - zf * simdmath.cos(e6)
+    out[5] = -e5 + u * simdmath.cos(epsilon) - zf * simdmath.sin(e6)
 
 
 @njit(cache=True)
@@ -226,40 +227,40 @@ def f_q(t, q, p, out):
     beta, Theta, gamma, Phi, delta, Omega, epsilon = q[0], q[1], q[2], q[3], q[4], q[5], q[6]
     d, e, rr, ss, u, zf, zt = p[21], p[23], p[25], p[28], p[35], p[38], p[39]
     e0 = Theta + beta
-    e1 = d * math.sin(e0)
-    e2 = e1 - rr * math.sin(beta)
-    e3 = d * math.cos(e0)
-    e4 = -e3 + rr * math.cos(beta)
+    e1 = d * simdmath.sin(e0)
+    e2 = e1 - rr * simdmath.sin(beta)
+    e3 = d * simdmath.cos(e0)
+    e4 = -e3 + rr * simdmath.cos(beta)
     e5 = -e3
     e6 = Phi + delta
-    e7 = e * math.cos(e6)
-    e8 = e * math.sin(e6)
+    e7 = e * simdmath.cos(e6)
+    e8 = e * simdmath.sin(e6)
     e9 = Omega + epsilon
-    e10 = math.sin(e9)
-    e11 = zf * math.cos(e9)
+    e10 = simdmath.sin(e9)
+    e11 = zf * simdmath.cos(e9)
     out[:, :] = 0.0
     out[0, 0] = e2
     out[0, 1] = e1
-    out[0, 2] = -ss * math.cos(gamma)
+    out[0, 2] = -ss * simdmath.cos(gamma)
     out[1, 0] = e4
     out[1, 1] = e5
-    out[1, 2] = -ss * math.sin(gamma)
+    out[1, 2] = -ss * simdmath.sin(gamma)
     out[2, 0] = e2
     out[2, 1] = e1
     out[2, 3] = -e7
-    out[2, 4] = -e7 + zt * math.sin(delta)
+    out[2, 4] = -e7 + zt * simdmath.sin(delta)
     out[3, 0] = e4
     out[3, 1] = e5
     out[3, 3] = -e8
-    out[3, 4] = -e8 - zt * math.cos(delta)
+    out[3, 4] = -e8 - zt * simdmath.cos(delta)
     out[4, 0] = e2
     out[4, 1] = e1
     out[4, 5] = e10 * zf
-    out[4, 6] = e10 * zf - u * math.cos(epsilon)
+    out[4, 6] = e10 * zf - u * simdmath.cos(epsilon)
     out[5, 0] = e4
     out[5, 1] = e5
     out[5, 5] = -e11
-    out[5, 6] = -e11 - u * math.sin(epsilon)
+    out[5, 6] = -e11 - u * simdmath.sin(epsilon)
 
 
 @njit(cache=True)
@@ -277,37 +278,37 @@ def f_accel(t, q, v, p, out):
     e0 = (gamma_dot * gamma_dot) * ss
     e1 = (Theta_dot * Theta_dot)
     e2 = Theta + beta
-    e3 = d * math.cos(e2)
+    e3 = d * simdmath.cos(e2)
     e4 = (beta_dot * beta_dot)
     e5 = e4 * rr
     e6 = 2.0 * Theta_dot * beta_dot
-    e7 = e1 * e3 + e3 * e4 + e3 * e6 - e5 * math.cos(beta)
-    e8 = math.sin(e2)
+    e7 = e1 * e3 + e3 * e4 + e3 * e6 - e5 * simdmath.cos(beta)
+    e8 = simdmath.sin(e2)
     e9 = d * e8
-    e10 = e5 * math.sin(beta)
+    e10 = e5 * simdmath.sin(beta)
     e11 = e1 * e9 - e10 + e4 * e9 + e6 * e9
     e12 = (Phi_dot * Phi_dot)
     e13 = Phi + delta
-    e14 = e * math.sin(e13)
+    e14 = e * simdmath.sin(e13)
     e15 = (delta_dot * delta_dot)
     e16 = 2.0 * Phi_dot * delta_dot
-    e17 = e * math.cos(e13)
+    e17 = e * simdmath.cos(e13)
     e18 = (epsilon_dot * epsilon_dot)
     e19 = e18 * u
     e20 = (Omega_dot * Omega_dot)
     e21 = Omega + epsilon
-    e22 = zf * math.cos(e21)
+    e22 = zf * simdmath.cos(e21)
     e23 = 2.0 * Omega_dot * epsilon_dot
-    e24 = zf * math.sin(e21)
-    out[0] = e0 * math.sin(gamma) + e7
-    out[1] = -e0 * math.cos(gamma) + e11
-    out[2] = e12 * e14 + e14 * e15 + e14 * e16 + e15 * zt * math.cos(delta) + e7
+    e24 = zf * simdmath.sin(e21)
+    out[0] = e0 * simdmath.sin(gamma) + e7
+    out[1] = -e0 * simdmath.cos(gamma) + e11
+    out[2] = e12 * e14 + e14 * e15 + e14 * e16 + e15 * zt * simdmath.cos(delta) + e7
     out[3] = (
         2.0 * Theta_dot * beta_dot * d * e8 + d * e1 * e8 + d * e4 * e8 - e10 - e12 * e17
-        - e15 * e17 + e15 * zt * math.sin(delta) - e16 * e17
+        - e15 * e17 + e15 * zt * simdmath.sin(delta) - e16 * e17
     )
-    out[4] = e18 * e22 + e19 * math.sin(epsilon) + e20 * e22 + e22 * e23 + e7
-    out[5] = e11 + e18 * e24 - e19 * math.cos(epsilon) + e20 * e24 + e23 * e24
+    out[4] = e18 * e22 + e19 * simdmath.sin(epsilon) + e20 * e22 + e22 * e23 + e7
+    out[5] = e11 + e18 * e24 - e19 * simdmath.cos(epsilon) + e20 * e24 + e23 * e24
 
 
 def reference_state(p):

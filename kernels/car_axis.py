@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 import stabdae
+from stabdae import simdmath
 
 # p = [eps, M, L, L0, r, w, g]
 
@@ -50,7 +51,7 @@ def forces(t, q, v, p, out):
     e0 = L0 / math.sqrt((xl * xl) + (yl * yl))
     e1 = 0.5 * M * (eps * eps) * g
     e2 = (L * L)
-    e3 = math.sin(t * w)
+    e3 = simdmath.sin(t * w)
     e4 = math.sqrt(e2 - (e3 * e3) * (r * r))
     e5 = e3 * r
     e6 = 1.0 / math.sqrt(e2 - 2.0 * e4 * xr - 2.0 * e5 * yr + (xr * xr) + (yr * yr))
@@ -65,7 +66,7 @@ def forces(t, q, v, p, out):
 def f(t, q, p, out):
     xl, yl, xr, yr = q[0], q[1], q[2], q[3]
     L, r, w = p[2], p[4], p[5]
-    e0 = math.sin(t * w)
+    e0 = simdmath.sin(t * w)
     e1 = (L * L)
     out[0] = e0 * r * yl + xl * math.sqrt(-(e0 * e0) * (r * r) + e1)
     out[1] = -e1 + (xl * xl) - 2.0 * xl * xr + (xr * xr) + (yl * yl) - 2.0 * yl * yr + (yr * yr)
@@ -75,7 +76,7 @@ def f(t, q, p, out):
 def f_q(t, q, p, out):
     xl, yl, xr, yr = q[0], q[1], q[2], q[3]
     L, r, w = p[2], p[4], p[5]
-    e0 = math.sin(t * w)
+    e0 = simdmath.sin(t * w)
     e1 = 2.0 * xl - 2.0 * xr
     e2 = 2.0 * yl - 2.0 * yr
     out[:, :] = 0.0
@@ -92,9 +93,9 @@ def f_t(t, q, p, out):
     xl, yl = q[0], q[1]
     L, r, w = p[2], p[4], p[5]
     e0 = t * w
-    e1 = math.cos(e0)
+    e1 = simdmath.cos(e0)
     e2 = (r * r)
-    e3 = math.sin(e0)
+    e3 = simdmath.sin(e0)
     out[0] = -e1 * e2 * e3 * w * xl / math.sqrt((L * L) - e2 * (e3 * e3)) + e1 * r * w * yl
     out[1] = 0.0
 
@@ -106,9 +107,9 @@ def f_accel(t, q, v, p, out):
     xl_dot, yl_dot, xr_dot, yr_dot = v[0], v[1], v[2], v[3]
     L, r, w = p[2], p[4], p[5]
     e0 = t * w
-    e1 = math.cos(e0)
+    e1 = simdmath.cos(e0)
     e2 = (w * w)
-    e3 = math.sin(e0)
+    e3 = simdmath.sin(e0)
     e4 = (r * r)
     e5 = (e1 * e1)
     e6 = (L * L)

@@ -33,6 +33,7 @@ import numpy as np
 from numba import njit
 
 import stabdae
+from stabdae import simdmath
 
 # p = [m, R, g, w0]
 
@@ -42,7 +43,7 @@ def mass(t, q, p, out):
     # M = ∂²L/∂v²
     theta = q[4]
     m, R = p[0], p[1]
-    e0 = math.cos(theta)
+    e0 = simdmath.cos(theta)
     e1 = (R * R) * m
     e2 = 0.25 * e1
     e3 = 0.5 * e1
@@ -63,8 +64,8 @@ def forces(t, q, v, p, out):
     theta = q[4]
     phi_dot, theta_dot, psi_dot = v[3], v[4], v[5]
     m, R, g = p[0], p[1], p[2]
-    e0 = phi_dot * math.cos(theta)
-    e1 = (R * R) * m * math.sin(theta)
+    e0 = phi_dot * simdmath.cos(theta)
+    e1 = (R * R) * m * simdmath.sin(theta)
     e2 = 0.5 * e1 * theta_dot
     out[0] = 0.0
     out[1] = 0.0
@@ -78,7 +79,7 @@ def forces(t, q, v, p, out):
 def f(t, q, p, out):
     z, theta = q[2], q[4]
     R = p[1]
-    out[0] = -R * math.sin(theta) + z
+    out[0] = -R * simdmath.sin(theta) + z
 
 
 @njit(cache=True)
@@ -87,7 +88,7 @@ def f_q(t, q, p, out):
     R = p[1]
     out[:, :] = 0.0
     out[0, 2] = 1.0
-    out[0, 4] = -R * math.cos(theta)
+    out[0, 4] = -R * simdmath.cos(theta)
 
 
 @njit(cache=True)
@@ -96,7 +97,7 @@ def f_accel(t, q, v, p, out):
     theta = q[4]
     theta_dot = v[4]
     R = p[1]
-    out[0] = R * (theta_dot * theta_dot) * math.sin(theta)
+    out[0] = R * (theta_dot * theta_dot) * simdmath.sin(theta)
 
 
 @njit(cache=True)
@@ -104,13 +105,13 @@ def h(t, q, v, p, out):
     phi, theta = q[3], q[4]
     x_dot, y_dot, phi_dot, theta_dot, psi_dot = v[0], v[1], v[3], v[4], v[5]
     R = p[1]
-    e0 = math.cos(phi)
+    e0 = simdmath.cos(phi)
     e1 = R * psi_dot
     e2 = R * e0
-    e3 = phi_dot * math.cos(theta)
-    e4 = math.sin(phi)
+    e3 = phi_dot * simdmath.cos(theta)
+    e4 = simdmath.sin(phi)
     e5 = R * e4
-    e6 = theta_dot * math.sin(theta)
+    e6 = theta_dot * simdmath.sin(theta)
     out[0] = e0 * e1 + e2 * e3 - e5 * e6 + x_dot
     out[1] = e1 * e4 + e2 * e6 + e3 * e5 + y_dot
 
@@ -120,11 +121,11 @@ def h_q(t, q, v, p, out):
     phi, theta = q[3], q[4]
     phi_dot, theta_dot, psi_dot = v[3], v[4], v[5]
     R = p[1]
-    e0 = math.sin(phi)
-    e1 = math.cos(theta)
+    e0 = simdmath.sin(phi)
+    e1 = simdmath.cos(theta)
     e2 = e0 * e1
-    e3 = math.cos(phi)
-    e4 = math.sin(theta)
+    e3 = simdmath.cos(phi)
+    e4 = simdmath.sin(theta)
     e5 = e3 * e4
     e6 = e0 * e4
     out[:, :] = 0.0
@@ -138,10 +139,10 @@ def h_q(t, q, v, p, out):
 def h_v(t, q, v, p, out):
     phi, theta = q[3], q[4]
     R = p[1]
-    e0 = math.cos(theta)
-    e1 = R * math.cos(phi)
-    e2 = math.sin(theta)
-    e3 = R * math.sin(phi)
+    e0 = simdmath.cos(theta)
+    e1 = R * simdmath.cos(phi)
+    e2 = simdmath.sin(theta)
+    e3 = R * simdmath.sin(phi)
     out[:, :] = 0.0
     out[0, 0] = 1.0
     out[0, 3] = e0 * e1
@@ -161,7 +162,7 @@ def energy(t, q, v, p):
     m, R, g = p[0], p[1], p[2]
     e0 = (R * R)
     e1 = e0 * (phi_dot * phi_dot)
-    e2 = math.cos(theta)
+    e2 = simdmath.cos(theta)
     return (
         0.125 * m
         * (
@@ -175,8 +176,8 @@ def energy(t, q, v, p):
 def reference_state(p):
     R, w0 = p[1], p[3]
     return np.array(
-        [0.0, 0.0, R * math.cos(0.3), 0.0, -0.3 + 0.5 * math.pi, 0.0,
-         -0.5 * R * (2.0 * w0 + 3.0 * math.sin(0.3)), 0.0, 0.0, 1.5, 0.0, w0],
+        [0.0, 0.0, R * simdmath.cos(0.3), 0.0, -0.3 + 0.5 * math.pi, 0.0,
+         -0.5 * R * (2.0 * w0 + 3.0 * simdmath.sin(0.3)), 0.0, 0.0, 1.5, 0.0, w0],
         dtype=np.float64,
     )
 

@@ -23,12 +23,11 @@ Edit the spec and regenerate rather than editing this file.
 """
 
 
-import math
-
 import numpy as np
 from numba import njit
 
 import stabdae
+from stabdae import simdmath
 
 # p = [r, l, m1, m2, m3, w0]
 
@@ -40,7 +39,7 @@ def mass(t, q, p, out):
     r, l, m1, m2, m3 = p[0], p[1], p[2], p[3], p[4]
     out[:, :] = 0.0
     out[0, 0] = (r * r) * (0.3333333333333333 * m1 + m2)
-    out[0, 1] = 0.5 * l * m2 * r * math.cos(phi - psi)
+    out[0, 1] = 0.5 * l * m2 * r * simdmath.cos(phi - psi)
     out[1, 1] = 0.3333333333333333 * (l * l) * m2
     out[2, 2] = m3
     out[1, 0] = out[0, 1]
@@ -52,7 +51,7 @@ def forces(t, q, v, p, out):
     phi, psi = q[0], q[1]
     phi_dot, psi_dot = v[0], v[1]
     r, l, m2 = p[0], p[1], p[3]
-    e0 = 0.5 * l * m2 * r * math.sin(phi - psi)
+    e0 = 0.5 * l * m2 * r * simdmath.sin(phi - psi)
     out[0] = e0 * (psi_dot * psi_dot)
     out[1] = -e0 * (phi_dot * phi_dot)
     out[2] = 0.0
@@ -62,8 +61,8 @@ def forces(t, q, v, p, out):
 def f(t, q, p, out):
     phi, psi, xs = q[0], q[1], q[2]
     r, l = p[0], p[1]
-    out[0] = l * math.cos(psi) + r * math.cos(phi) - xs
-    out[1] = l * math.sin(psi) + r * math.sin(phi)
+    out[0] = l * simdmath.cos(psi) + r * simdmath.cos(phi) - xs
+    out[1] = l * simdmath.sin(psi) + r * simdmath.sin(phi)
 
 
 @njit(cache=True)
@@ -71,11 +70,11 @@ def f_q(t, q, p, out):
     phi, psi = q[0], q[1]
     r, l = p[0], p[1]
     out[:, :] = 0.0
-    out[0, 0] = -r * math.sin(phi)
-    out[0, 1] = -l * math.sin(psi)
+    out[0, 0] = -r * simdmath.sin(phi)
+    out[0, 1] = -l * simdmath.sin(psi)
     out[0, 2] = -1.0
-    out[1, 0] = r * math.cos(phi)
-    out[1, 1] = l * math.cos(psi)
+    out[1, 0] = r * simdmath.cos(phi)
+    out[1, 1] = l * simdmath.cos(psi)
 
 
 @njit(cache=True)
@@ -86,8 +85,8 @@ def f_accel(t, q, v, p, out):
     r, l = p[0], p[1]
     e0 = l * (psi_dot * psi_dot)
     e1 = (phi_dot * phi_dot) * r
-    out[0] = -e0 * math.cos(psi) - e1 * math.cos(phi)
-    out[1] = -e0 * math.sin(psi) - e1 * math.sin(phi)
+    out[0] = -e0 * simdmath.cos(psi) - e1 * simdmath.cos(phi)
+    out[1] = -e0 * simdmath.sin(psi) - e1 * simdmath.sin(phi)
 
 
 @njit(cache=True)
@@ -100,7 +99,7 @@ def energy(t, q, v, p):
     e1 = 0.5 * m2
     return (
         e0 * e1 + 0.16666666666666666 * e0 * m1
-        + e1 * l * phi_dot * psi_dot * r * math.cos(phi - psi)
+        + e1 * l * phi_dot * psi_dot * r * simdmath.cos(phi - psi)
         + 0.16666666666666666 * (l * l) * m2 * (psi_dot * psi_dot) + 0.5 * m3 * (xs_dot * xs_dot)
     )
 

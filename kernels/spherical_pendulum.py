@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 import stabdae
+from stabdae import simdmath
 
 # p = [m, g, l]
 
@@ -83,8 +84,8 @@ def energy(t, q, v, p):
 def reference_state(p):
     g, l = p[1], p[2]
     return np.array(
-        [l * math.sin(0.5), 0.0, -l * math.cos(0.5), 0.0,
-         l * math.sqrt(g / l) * math.sin(0.5) / math.sqrt(math.cos(0.5)), 0.0],
+        [l * simdmath.sin(0.5), 0.0, -l * simdmath.cos(0.5), 0.0,
+         l * math.sqrt(g / l) * simdmath.sin(0.5) / math.sqrt(simdmath.cos(0.5)), 0.0],
         dtype=np.float64,
     )
 

@@ -59,7 +59,7 @@ __all__ = ["System", "SymbolicError", "coordinates", "t", "generate", "load_spec
 t = sp.Symbol("t")
 
 #: names the generated functions use for their own arguments and modules
-_RESERVED = {"t", "q", "v", "p", "out", "math", "np", "njit", "stabdae", "model",
+_RESERVED = {"t", "q", "v", "p", "out", "math", "np", "njit", "stabdae", "simdmath", "model",
              "reference_state", "mass", "forces", "f", "f_q", "f_t", "f_accel", "h",
              "h_q", "h_v", "h_t", "energy"}  # fmt: skip
 _WIDTH = 100
@@ -313,8 +313,11 @@ class System:
         names = _LocalNames(self)
         code = [_function(piece, expr, names) for piece, expr in pieces.items()]
         code.append(self._reference_function(names))
-        imports = _IMPORTS if any("math." in c for c in code) else _IMPORTS.replace(
-            "import math\n\n", "")
+        imports = _IMPORTS
+        if not any(re.search(r"(?<![.\w])math\.", c) for c in code):
+            imports = imports.replace("import math\n\n", "")
+        if not any("simdmath." in c for c in code):
+            imports = imports.replace("\nfrom stabdae import simdmath", "")
         params = "\n".join(textwrap.wrap("p = [" + ", ".join(str(s) for s in self.params) + "]",
                                          _WIDTH - 2, initial_indent="# ",
                                          subsequent_indent="#     "))  # fmt: skip
@@ -392,7 +395,8 @@ class System:
         return "model = stabdae.Model(\n" + "".join(f"    {a},\n" for a in args) + ")"
 
 
-_IMPORTS = "import math\n\nimport numpy as np\nfrom numba import njit\n\nimport stabdae"
+_IMPORTS = ("import math\n\nimport numpy as np\nfrom numba import njit\n\nimport stabdae\n"
+            "from stabdae import simdmath")
 
 def _signature(piece: str) -> str:
     """Arguments of a generated function, from the model's table of pieces."""
@@ -430,6 +434,14 @@ class _Printer(PythonCodePrinter):
 
     def _print_Float(self, expr):
         return repr(float(expr))
+
+    # the sine and cosine that vectorize with the ensemble kernel's member loop (a call to
+    # the C library's would run one lane at a time)
+    def _print_sin(self, expr):
+        return f"simdmath.sin({self._print(expr.args[0])})"
+
+    def _print_cos(self, expr):
+        return f"simdmath.cos({self._print(expr.args[0])})"
 
     def _print_Pow(self, expr, rational=False):
         base, e = expr.as_base_exp()
