@@ -152,21 +152,54 @@ model = stabdae.load_model(sys.argv[1])
 ds = stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 1e-3, 0.3,
                       members=300, seed=9, block=16)
 print(json.dumps({"threads": numba.get_num_threads(),
+                  "wide": ds.attrs["prefer_512_bit_vectors"],
+                  "features": numba.config.CPU_FEATURES or "",
                   "x": ds.x_final.values.tobytes().hex(),
                   "r": ds.residual_norm.values.tobytes().hex()}))
 """
 
 
-def test_thread_count_does_not_change_any_number():
+def test_thread_count_and_vector_width_do_not_change_any_number():
+    """One thread or two, 512-bit SIMD vectors (where the CPU has AVX-512) or the
+    compiler's default width: the same bits."""
+    from numba.core.codegen import get_host_cpu_features
+
     out = {}
-    for threads in ("1", "2"):
-        env = dict(os.environ, NUMBA_NUM_THREADS=threads)
+    base = {k: v for k, v in os.environ.items()
+            if k not in ("STABDAE_VECTOR_WIDTH", "NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME")}
+    for run, env in (("1", dict(base, NUMBA_NUM_THREADS="1")),
+                     ("2", dict(base, NUMBA_NUM_THREADS="2")),
+                     ("256", dict(base, NUMBA_NUM_THREADS="2", STABDAE_VECTOR_WIDTH="256"))):
         proc = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT,
                                str(ROOT / "kernels" / "pendulum.py")],
                               capture_output=True, text=True, env=env, check=True)  # fmt: skip
-        out[threads] = json.loads(proc.stdout.strip().splitlines()[-1])
+        out[run] = json.loads(proc.stdout.strip().splitlines()[-1])
     assert out["1"]["threads"] == 1
-    assert out["1"]["x"] == out["2"]["x"] and out["1"]["r"] == out["2"]["r"]
+    avx512 = "+avx512f" in get_host_cpu_features().split(",")
+    assert out["2"]["wide"] == int(avx512) and out["256"]["wide"] == 0
+    assert ("-prefer-256-bit" in out["2"]["features"]) == avx512
+    assert "-prefer-256-bit" not in out["256"]["features"]
+    for other in ("2", "256"):
+        assert out["1"]["x"] == out[other]["x"] and out["1"]["r"] == out[other]["r"], other
+
+
+def test_vector_width_is_chosen_only_where_numba_leaves_it_open(monkeypatch):
+    from numba import config
+    from numba.core.codegen import get_host_cpu_features
+
+    from stabdae import _vector_width
+
+    monkeypatch.setattr(config, "CPU_FEATURES", None)
+    # this process has compiled: numba's features are fixed, nothing may change them
+    assert _vector_width.choose({}) is False and config.CPU_FEATURES is None
+    # a user's own features stand (here in a fresh process, where the choice is open)
+    host = get_host_cpu_features()
+    env = dict(os.environ, NUMBA_CPU_FEATURES=host)
+    env.pop("STABDAE_VECTOR_WIDTH", None)
+    proc = subprocess.run([sys.executable, "-c", "import numba, stabdae; "
+                           "print(stabdae._vector_width.PREFER_512, numba.config.CPU_FEATURES)"],
+                          capture_output=True, text=True, env=env, check=True)  # fmt: skip
+    assert proc.stdout.split() == ["False", host]
 
 
 def test_divergence_is_isolated():

@@ -7,7 +7,8 @@ below it: :mod:`stabdae.kernels` (compiled), the drivers and definitions here,
 :mod:`stabdae.study` (study files, runs, command line).
 """
 
-from . import theory
+# _vector_width first: numba's CPU features are fixed by the first compiled function
+from . import _vector_width, theory  # noqa: F401
 from ._adaptive import integrate_adaptive
 from ._boundary import boundary
 from ._ensemble import ensemble, sample_perturbations

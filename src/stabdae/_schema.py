@@ -29,6 +29,7 @@ import xarray as xr
 
 from ._measures import CLASSES, STAGES, TAU_STAR_REASONS
 from ._status import Status, status_flag_attrs
+from ._vector_width import PREFER_512
 from ._version import __version__
 from .kernels.decay import KINDS, REASONS
 from .kernels.fma import HOST_FMA
@@ -457,6 +458,8 @@ def provenance(model, p: np.ndarray | None, law, scheme, action: str, **run) -> 
         # 1: the library's multiply-adds were fused (kernels.fma); results differ at
         # roundoff from a machine without FMA, which computes them with two roundings
         "fused_multiply_add": int(HOST_FMA),
+        # 1: compiled for 512-bit SIMD vectors (the same bits as with 256: speed only)
+        "prefer_512_bit_vectors": int(PREFER_512),
     }
     if p is not None:
         attrs.update(flat_attrs("model_param_", dict(zip(model.param_names, p.tolist()))))
