@@ -8,7 +8,9 @@ first call (compiling the sampler, the reference stepper and the ensemble kernel
 integrating) and the best of ``--repeat`` further calls' ``wall_integrate_s`` (the kernel
 on every thread), with a digest of the final states, which must be equal between the two
 revisions when the change moved no number.  ``--baseline`` takes a git revision, checked
-out in a temporary worktree.  The results go to ``results/dense_models.json``.
+out in a temporary worktree; each revision runs its own model files.  The environment is
+passed on (``STABDAE_VECTOR_WIDTH=256`` runs this revision at the compiler's default
+vector width).  The results go to ``results/dense_models.json``.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ CONFIGS = [
     ("slider_crank", "rk4", 100.0, 1e-4, 0.2, 4000),
     ("double_pendulum", "midpoint", 10.0, 1e-3, 2.0, 10000),
     ("spherical_pendulum", "rk4", 10.0, 1e-3, 2.0, 4000),
+    ("pendulum", "dop853", 10.0, 0.02, 10.0, 10000),  # diagonal mass: the width alone
 ]
 
 _CHILD = """
@@ -52,10 +55,12 @@ print(json.dumps(dict(first_call_s=first, wall_integrate_s=best, final_states=di
 """
 
 
-def _run(src: Path, config, repeat: int, cache: Path) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(src), STABDAE_CACHE_DIR=str(cache))
+def _run(tree: Path, config, repeat: int, cache: Path) -> dict:
+    """One configuration with the library and the model files of ``tree`` (a generated
+    model file uses what its own revision's generator emitted)."""
+    env = dict(os.environ, PYTHONPATH=str(tree / "src"), STABDAE_CACHE_DIR=str(cache))
     out = subprocess.run([sys.executable, "-c", _CHILD, *map(str, config), str(repeat),
-                          str(HERE.parent / "kernels")], env=env, check=True,
+                          str(tree / "kernels")], env=env, check=True,
                          capture_output=True, text=True).stdout  # fmt: skip
     return json.loads(out.strip().splitlines()[-1])
 
@@ -67,11 +72,11 @@ def main(argv=None):
     ap.add_argument("--out", type=Path, default=HERE / "results")
     args = ap.parse_args(argv)
     tmp = Path(tempfile.mkdtemp(prefix="stabdae-dense-"))
-    trees = {"this": HERE.parent / "src"}
+    trees = {"this": HERE.parent}
     if args.baseline:
         subprocess.run(["git", "-C", str(HERE.parent), "worktree", "add", "--detach",
                         str(tmp / "tree"), args.baseline], check=True, capture_output=True)
-        trees[args.baseline] = tmp / "tree" / "src"
+        trees[args.baseline] = tmp / "tree"
     rows = []
     try:
         for config in CONFIGS:
@@ -96,7 +101,9 @@ def main(argv=None):
                             str(tmp / "tree")], check=False, capture_output=True)  # fmt: skip
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "dense_models.json").write_text(json.dumps(
-        dict(baseline=args.baseline, cpus=os.cpu_count(), rows=rows), indent=1))
+        dict(baseline=args.baseline, cpus=os.cpu_count(),
+             vector_width=os.environ.get("STABDAE_VECTOR_WIDTH", "512 where the CPU has it"),
+             rows=rows), indent=1))
 
 
 if __name__ == "__main__":

@@ -2,7 +2,8 @@
 numerical integration, after R. G. Mukharlyamov's constraint-perturbation equations.
 
 The public API is exactly what this module re-exports, plus the submodules
-:mod:`stabdae.theory`, :mod:`stabdae.symbolic` and :mod:`stabdae.plots`.  The floors
+:mod:`stabdae.theory`, :mod:`stabdae.symbolic`, :mod:`stabdae.simdmath` and
+:mod:`stabdae.plots`.  The floors
 below it: :mod:`stabdae.kernels` (compiled), the drivers and definitions here,
 :mod:`stabdae.study` (study files, runs, command line).
 """
