@@ -19,8 +19,12 @@ given radii, seed 0), integrated under the Baumgarte law (ω, ξ = 1) to ``t_end
   converted with ``heyoka.from_sympy``, and the two symmetric positive definite solves
   (M y = γ, M Y = Fᵀ; S λ = r with S = F Y) written as Gaussian elimination without
   pivoting over heyoka expressions, skipping structural zeros; over a ladder of
-  tolerances, (a) one thread, a loop over batches reusing one integrator, and (b)
-  ``heyoka.ensemble_propagate_until_batch`` on every thread;
+  tolerances, (a) one thread, a loop over batches reusing one integrator, (b) the same
+  loop on every thread, one integrator each, and (c)
+  ``heyoka.ensemble_propagate_until_batch`` on every thread; at heyoka's recommended
+  batch size and, where the CPU has AVX-512 and heyoka recommends 4, also at 8 (as
+  stabdae's kernels, :mod:`stabdae._vector_width`), the driver (c) at the recommended
+  size only;
 * ``diffrax.diffeqsolve`` with ``Tsit5`` and a PID controller, ``jax.vmap`` over members
   and ``jax.jit``, on the first ``--diffrax-members`` members and tolerances down to 1e-9
   (slower runs take minutes), when jax and diffrax are installed: the spec's pieces as
@@ -241,12 +245,25 @@ def heyoka_system(name: str, omega: float, xi: float = 1.0):
                                 for j in range(n)]  # fmt: skip
 
 
+def heyoka_batches():
+    """heyoka's recommended batch size and, on a CPU with AVX-512 where it recommends 4
+    (256-bit vectors, as LLVM prefers on most Intel models), 8 as well: stabdae's kernels
+    run 512-bit vectors there, and the comparison takes each tool at its best."""
+    import heyoka as hy
+    from numba.core.codegen import get_host_cpu_features
+
+    sizes = {hy.recommended_simd_size()}
+    if "+avx512f" in get_host_cpu_features().split(","):
+        sizes.add(8)
+    return sorted(sizes)
+
+
 class Heyoka:
-    def __init__(self, system, x0, t_end):
+    def __init__(self, system, x0, t_end, batch=None):
         import heyoka as hy
 
         self.hy, self.system, self.t_end = hy, system, t_end
-        self.batch = hy.recommended_simd_size()
+        self.batch = batch or hy.recommended_simd_size()
         self.M = x0.shape[0]  # padded to whole batches with copies of the last member
         self.x0 = np.concatenate([x0, np.repeat(x0[-1:], -self.M % self.batch, axis=0)])
 
@@ -435,15 +452,18 @@ def run_scene(scene: Scene, members: int, repeat: int, quick: bool, diffrax_memb
             ds, wall = best_time(partial(stabdae_run, "dop853", steps=steps, threads=1), repeat)
             record("stabdae", "dop853 fixed, 1 thread", scene.t_end / steps,
                    ds["x_final"].values, wall, 1)  # fmt: skip
-    for tol in ladder(scene.heyoka_tols):
-        ta, built = hy_.integrator(tol)
-        compile_s[f"heyoka tol={tol:g}"] = built
-        x, wall = best_time(partial(hy_.one_thread, ta), repeat)
-        record("heyoka", "batch, 1 thread", tol, x, wall, 1)
-        x, wall = best_time(partial(hy_.threaded, ta, threads), repeat)
-        record("heyoka", f"batch, {threads} threads", tol, x, wall, threads)
-        x, wall = best_time(partial(hy_.ensemble, ta, threads), repeat)
-        record("heyoka", f"ensemble driver, {threads} thr.", tol, x, wall, threads)
+    for batch in heyoka_batches():
+        hy_b = Heyoka(system, x0, scene.t_end, batch)
+        for tol in ladder(scene.heyoka_tols):
+            ta, built = hy_b.integrator(tol)
+            compile_s[f"heyoka batch {batch} tol={tol:g}"] = built
+            x, wall = best_time(partial(hy_b.one_thread, ta), repeat)
+            record("heyoka", f"batch of {batch}, 1 thread", tol, x, wall, 1)
+            x, wall = best_time(partial(hy_b.threaded, ta, threads), repeat)
+            record("heyoka", f"batch of {batch}, {threads} thr.", tol, x, wall, threads)
+            if batch == hy_.batch:  # 20-60x the batch loops in every run so far
+                x, wall = best_time(partial(hy_b.ensemble, ta, threads), repeat)
+                record("heyoka", f"ensemble driver, {threads} thr.", tol, x, wall, threads)
     try:
         dfx = Diffrax(scene.name, scene.omega, x0[:diffrax_members], scene.t_end)
     except ImportError:
@@ -547,7 +567,9 @@ def main(argv=None):
     meta = dict(machine=platform.processor() or platform.machine(), cpus=os.cpu_count(),
                 threads=numba.get_num_threads(), stabdae=stabdae.__version__,
                 heyoka=heyoka.__version__, numba=numba.__version__,
-                simd=heyoka.recommended_simd_size(), argv=sys.argv[1:])  # fmt: skip
+                simd=heyoka.recommended_simd_size(), heyoka_batches=heyoka_batches(),
+                stabdae_512_bit_vectors=stabdae._vector_width.PREFER_512,
+                argv=sys.argv[1:])  # fmt: skip
     for name in args.scenes:
         rows, compile_s, agreement = run_scene(SCENES[name], args.members, args.repeat,
                                                args.quick, args.diffrax_members)  # fmt: skip
