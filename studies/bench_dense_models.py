@@ -1,7 +1,7 @@
 """Ensembles of models on the dense path (a mass matrix that is not diagonal), this
 revision against an earlier one, in one run.
 
-    python studies/bench_dense_models.py [--baseline REV] [--repeat 3]
+    python studies/bench_dense_models.py [--baseline REV] [--repeat 3] [--only SCENE:SCHEME ...]
 
 Each configuration runs in a fresh process per revision with a fresh kernel cache: the
 first call (compiling the sampler, the reference stepper and the ensemble kernel, then
@@ -70,7 +70,13 @@ def main(argv=None):
     ap.add_argument("--baseline", metavar="REV", default=None)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--out", type=Path, default=HERE / "results")
+    ap.add_argument("--only", nargs="+", metavar="SCENE:SCHEME", default=None,
+                    help="run these configurations only (e.g. andrews:dop853)")
     args = ap.parse_args(argv)
+    configs = [c for c in CONFIGS if args.only is None or f"{c[0]}:{c[1]}" in args.only]
+    if not configs:
+        ap.error(f"--only {' '.join(args.only)}: none of "
+                 + ", ".join(f"{c[0]}:{c[1]}" for c in CONFIGS))
     tmp = Path(tempfile.mkdtemp(prefix="stabdae-dense-"))
     trees = {"this": HERE.parent}
     if args.baseline:
@@ -79,7 +85,7 @@ def main(argv=None):
         trees[args.baseline] = tmp / "tree"
     rows = []
     try:
-        for config in CONFIGS:
+        for config in configs:
             row = dict(zip(("scene", "scheme", "omega", "tau", "t_end", "members"), config))
             for name, src in trees.items():
                 row[name] = _run(src, config, args.repeat, tmp / f"cache-{len(rows)}-{name}")
