@@ -107,12 +107,16 @@ def _kcos(x, y):
 
 
 @njit(cache=True, forceinline=True, error_model="numpy")
+def _quadrant(x):
+    """``(q, q odd, sin r, cos r)`` for ``x = n·π/2 + r``, ``q = n mod 4``."""
+    q, y0, y1 = _reduce(x)
+    return q, (q == 1.0) | (q == 3.0), _ksin(y0, y1), _kcos(y0, y1)
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
 def sin(x):
     """The sine of ``x`` (radians), within one ulp for ``|x| < 1.6·10⁶``; vectorizes."""
-    q, y0, y1 = _reduce(x)
-    s = _ksin(y0, y1)
-    c = _kcos(y0, y1)
-    odd = (q == 1.0) | (q == 3.0)
+    q, odd, s, c = _quadrant(x)
     u = c if odd else s
     return -u if q >= 2.0 else u
 
@@ -120,9 +124,6 @@ def sin(x):
 @njit(cache=True, forceinline=True, error_model="numpy")
 def cos(x):
     """The cosine of ``x`` (radians), within one ulp for ``|x| < 1.6·10⁶``; vectorizes."""
-    q, y0, y1 = _reduce(x)
-    s = _ksin(y0, y1)
-    c = _kcos(y0, y1)
-    odd = (q == 1.0) | (q == 3.0)
+    q, odd, s, c = _quadrant(x)
     u = s if odd else c
     return -u if (q == 1.0) | (q == 2.0) else u
