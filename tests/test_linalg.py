@@ -148,3 +148,66 @@ def test_written_out_routines_of_size_zero_do_nothing():
     ldl_solve_columns_for(0, 2)(np.eye(3), 0, np.eye(3), 2)
     ldl_solve_columns_for(3, 0)(np.eye(3), 3, np.eye(3), 0)
     assert np.array_equal(b, np.arange(3.0))
+
+
+def _nested(a):
+    return tuple(tuple(bool(v) for v in row) for row in a)
+
+
+@pytest.mark.parametrize("shape", ["blocks", "arrow"])
+def test_written_out_routines_for_a_pattern_skip_its_zeros_only(shape):
+    """With the matrix's structural zeros given, the written-out factor and solves do the
+    dense routines' operations minus the structurally zero terms: the same numbers up to
+    the sign of a zero on the factor's pattern (its fill included: an arrow matrix whose
+    first row is full fills in completely), the entries off it neither read nor written,
+    and the solution's non-zeros where :func:`solve_pattern` says."""
+    from stabdae.kernels.linalg import (
+        factor_ops,
+        ldl_factor_for,
+        ldl_solve_columns_for,
+        ldl_solve_for,
+        solve_pattern,
+    )
+    from stabdae.kernels.sparsity import fill_pattern
+
+    n = 7
+    if shape == "blocks":  # Andrews' mass matrix: pairs of coupled angles and a single one
+        pat = np.zeros((n, n), dtype=bool)
+        for lo, hi in ((0, 2), (2, 3), (3, 5), (5, 7)):
+            pat[lo:hi, lo:hi] = True
+    else:  # arrow: every entry of row and column 0 and the diagonal
+        pat = np.eye(n, dtype=bool)
+        pat[0, :] = pat[:, 0] = True
+    fill = fill_pattern(np.tril(pat))
+    assert shape == "blocks" or fill.sum() == n * (n + 1) // 2  # the arrow fills in
+    rng = np.random.default_rng(3)
+    B = rng.standard_normal((n, n)) * pat
+    A = (B @ B.T + np.eye(n)) * pat  # SPD with exactly that pattern
+    key = _nested(np.tril(pat))
+    assert factor_ops(n, key) < factor_ops(n, None) or shape == "arrow"
+    dense = A.copy()
+    assert ldl_inplace(dense, n, 1e-14) == 0
+    buf = np.where(fill, A, 5.0)  # off the factor's pattern: a value no sum may read
+    buf[np.triu_indices(n, 1)] = 3.0
+    assert ldl_factor_for(n, key)(buf, n, 1e-14) == 0
+    np.testing.assert_array_equal(buf[fill], dense[fill])
+    assert np.all(buf[np.tril(~fill)] == 5.0) and np.all(buf[np.triu_indices(n, 1)] == 3.0)
+    b = rng.standard_normal(n)
+    x, xd = b.copy(), b.copy()
+    ldl_solve_for(n, key)(buf, n, x)
+    ldl_solve_inplace(dense, n, xd)
+    np.testing.assert_array_equal(x, xd)
+    # right sides with structural zeros: column c has non-zeros in rows c and c + 3 only
+    cols = np.zeros((n, 3), dtype=bool)
+    for c in range(3):
+        cols[[c, c + 3], c] = True
+    Xpat, ops = solve_pattern(np.tril(pat), cols)
+    Bm = np.where(cols, rng.standard_normal((n, 3)), 0.0)
+    Xd = Bm.copy()
+    ldl_solve_columns(dense, n, Xd, 3)
+    X = np.where(cols, Bm, 9.0)  # 9: entries the solve must not read (it writes Xpat's)
+    ldl_solve_columns_for(n, 3, key, _nested(cols))(buf, n, X, 3)
+    np.testing.assert_array_equal(X[Xpat], Xd[Xpat])
+    assert np.all(Xd[~Xpat] == 0.0) and np.all(X[~Xpat] == 9.0)
+    if shape == "blocks":  # a column's non-zeros fill their blocks, no more
+        assert Xpat.sum() == 4 + 4 + 3 and ops < n * n * 3

@@ -18,9 +18,12 @@ The kernel factory closes over the model's dispatchers and over compile-time fla
 present, m, k, time dependence, law kind).  Absent pieces are replaced by no-op stubs
 behind branches on those constants, which LLVM removes: an identity-mass model compiles
 no factorization of ``M``, a model with ``k = 0`` no nonholonomic block, a scleronomic
-model no ``f_t`` call.  Every buffer lives in a named workspace (:mod:`.workspace`)
-allocated once per integration; an evaluation allocates nothing and returns a
-:class:`~stabdae.Status` code.
+model no ``f_t`` call.  The constraint part takes one of three forms: the sparse path
+(a diagonal or absent mass matrix and sparse constraints: index lists, :mod:`.sparsity`),
+the dense path written out without the model's structural zeros (:func:`_structured`:
+a mass matrix of blocks, few couplings), or the dense loops.  Every buffer lives in a
+named workspace (:mod:`.workspace`) allocated once per integration; an evaluation
+allocates nothing and returns a :class:`~stabdae.Status` code.
 
 Sums start from ``-0.0``, the exact identity of IEEE addition, so LLVM drops the start
 (``0.0 + x`` is not ``x`` for ``x = -0.0`` and would stay in the vectorized loop as one
@@ -42,6 +45,9 @@ from .cache import fingerprint, memo, optional_fingerprint, tag
 from .fma import fma
 from .jit import python_function
 from .linalg import (
+    UNROLL_MAX_OPS,
+    _written_out,
+    factor_ops,
     ldl_factor_for,
     ldl_inplace,
     ldl_solve_columns,
@@ -52,6 +58,7 @@ from .linalg import (
     ldl_sparse_solve,
     pinv_solve_sym,
     pivot_tolerance,
+    solve_pattern,
 )
 from .workspace import builders
 
@@ -83,6 +90,11 @@ MULTIPLIERS = ("ldl", "lstsq")
 _OK = int(Status.OK)
 _SINGULAR_S = int(Status.SINGULAR_S)
 _MASS_NOT_SPD = int(Status.MASS_NOT_SPD)
+
+
+@njit(cache=True, forceinline=True)
+def _noop3(a, b, out):  # stands in for an absent written-out piece
+    pass
 
 
 @njit(cache=True, forceinline=True)
@@ -359,6 +371,85 @@ def _pieces(model: Model, sparse: bool) -> SimpleNamespace:
     return SimpleNamespace(**locals())
 
 
+def _nested(a) -> tuple:
+    return tuple(tuple(bool(v) for v in row) for row in a)
+
+
+def _structured(model: Model, n: int, m: int, k: int) -> SimpleNamespace | None:
+    """The dense path's linear algebra written out for the model's structural zeros.
+
+    A mass matrix that is not diagonal rules out the sparse path (:mod:`.sparsity`), but
+    it is often block diagonal (a body's coordinates couple among themselves only), and
+    each constraint touches a few coordinates.  Here ``M``'s factor, ``Y = M⁻¹ Fᵀ``,
+    ``z = M⁻¹ γ``, ``S = F Y`` and its factor, ``F z`` and ``Y λ`` are written out for the
+    sizes and patterns of the model (:mod:`.linalg`): the dense path's operations in its
+    order without the terms that are structurally zero, so the two agree to the sign of a
+    zero.  None where the model has no patterns, where they save nothing, or where a
+    piece would exceed ``UNROLL_MAX_OPS`` multiply-adds (its code grows with them).
+    """
+    pats = model.patterns
+    r = m + k
+    if pats is None or r == 0:
+        return None
+    F = np.zeros((r, n), dtype=bool)
+    if m:
+        F[:m] = pats["f_q"]
+    if k:
+        F[m:] = pats["h_v"]
+    has_mass = "mass" in model.functions
+    M = np.asarray(pats["mass"], dtype=bool) if has_mass else None
+    if has_mass:
+        Ypat, y_ops = solve_pattern(np.tril(M), F.T)
+        m_ops = factor_ops(n, np.tril(M))
+    else:
+        Ypat, y_ops, m_ops = F.T.copy(), 0, 0
+    Sfull = (F.astype(np.int64) @ Ypat.astype(np.int64)) > 0
+    S = np.tril(Sfull)
+    gram_ops = int(sum((F[i] & Ypat[:, c]).sum() for i in range(r) for c in range(i + 1)))
+    s_ops = factor_ops(r, S)
+    ops = (m_ops, y_ops, gram_ops, s_ops)
+    dense = (n**3 // 6 if has_mass else 0, n * n * r if has_mass else 0,
+             n * r * (r + 1) // 2, r**3 // 6)  # fmt: skip
+    if max(ops) > UNROLL_MAX_OPS or sum(ops) + F.sum() + Ypat.sum() >= sum(dense) + 2 * n * r:
+        return None
+
+    def entry(i, j):
+        return f"fq[{i}, {j}]" if i < m else f"hv[{i - m}, {j}]"
+
+    load = [f"Y[{j}, {i}] = {entry(i, j)}" for i in range(r) for j in range(n) if F[i, j]]
+    gram = []
+    for i in range(r):
+        for c in range(i + 1):
+            gram.append("s = -0.0")
+            gram += [f"s = fma({entry(i, j)}, Y[{j}, {c}], s)" for j in range(n)
+                     if F[i, j] and Ypat[j, c]]  # fmt: skip
+            gram.append(f"S[{i}, {c}] = s")  # every entry: the factor's fill reads zeros
+    add_fz = []
+    for i in range(r):
+        add_fz.append(f"s = rl[{i}]")
+        add_fz += [f"s = fma({entry(i, j)}, z[{j}], s)" for j in range(n) if F[i, j]]
+        add_fz.append(f"rl[{i}] = s")
+    accel = []
+    for j in range(n):
+        accel.append(f"s = -z[{j}]")
+        accel += [f"s = fma(Y[{j}, {i}], rl[{i}], s)" for i in range(r) if Ypat[j, i]]
+        accel += [f"xdot[{j}] = v[{j}]", f"xdot[{n + j}] = s"]
+    tag_ = model.structure_key()[:8]
+    return SimpleNamespace(
+        ops=ops,
+        factor_M=ldl_factor_for(n, _nested(np.tril(M))) if has_mass else None,
+        solve_M=ldl_solve_for(n, _nested(np.tril(M))) if has_mass else None,
+        solve_columns_M=(ldl_solve_columns_for(n, r, _nested(np.tril(M)), _nested(F.T))
+                         if has_mass else None),  # fmt: skip
+        factor_S=ldl_factor_for(r, _nested(S)),
+        solve_S=ldl_solve_for(r, _nested(S)),
+        load_Ft=_written_out("def load_Ft(fq, hv, Y):", load, f"load_Ft_{tag_}"),
+        gram=_written_out("def gram(fq, hv, Y, S):", gram, f"gram_{tag_}"),
+        add_Fz=_written_out("def add_Fz(fq, hv, z, rl):", add_fz, f"add_Fz_{tag_}"),
+        accel=_written_out("def accel(Y, z, rl, v, xdot):", accel, f"accel_{tag_}"),
+    )
+
+
 def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     # The sparse path (:mod:`.sparsity`) where the model's structure pays for it; not for
     # the least-squares multiplier or the correction of Ascher et al., which stay dense.
@@ -381,6 +472,19 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     factor_M, solve_M, solve_columns_M = (ldl_factor_for(n), ldl_solve_for(n),
                                           ldl_solve_columns_for(n, r))  # fmt: skip
     factor_S, solve_S, solve_Sm = ldl_factor_for(r), ldl_solve_for(r), ldl_solve_for(m)
+    # the same, written out for the model's structural zeros where they pay (not for the
+    # least-squares multiplier or the correction of Ascher et al., which read all of S)
+    plan = None
+    if not (SPARSE or lstsq or law_code == LAW_ACPR):
+        plan = memo(model, ("structured",), lambda: _structured(model, n, m, k))
+    STRUCTURED = plan is not None
+    if STRUCTURED:
+        factor_S, solve_S = plan.factor_S, plan.solve_S
+        if HAS_MASS:
+            factor_M, solve_M, solve_columns_M = plan.factor_M, plan.solve_M, plan.solve_columns_M
+        load_Ft, gram, add_Fz, accel = plan.load_Ft, plan.gram, plan.add_Fz, plan.accel
+    else:  # never called (the branches on STRUCTURED are pruned), but typed
+        load_Ft, gram, add_Fz, accel = _noop3, _noop4, _noop4, _noop5
 
     @njit(forceinline=True, error_model="numpy")
     def rhs(t, x, p, law_mat, law_scal, ws, xdot):
@@ -480,6 +584,18 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
                     s = fma(Y[j, i], rl[i], s)
                 xdot[j] = v[j]
                 xdot[n + j] = s
+        elif STRUCTURED:
+            load_Ft(fq, hv, Y)
+            if HAS_MASS:
+                mass(t, q, p, Mw)
+                bad_mass = factor_M(Mw, n, MASS_RTOL) != 0
+                solve_columns_M(Mw, n, Y, r)
+                solve_M(Mw, n, z)
+            add_Fz(fq, hv, z, rl)
+            gram(fq, hv, Y, S)
+            bad_S = factor_S(S, r, S_RTOL) != 0
+            solve_S(S, r, rl)  # rl is now λ
+            accel(Y, z, rl, v, xdot)
         else:
             _load_Ft(fq, hv, Y, m, r, n)
             if HAS_MASS:
@@ -535,8 +651,10 @@ def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
 
     # the model's part of the key is the pieces' (its functions, energy and structure);
     # None (no cache) where that is
+    flags = (("lstsq",) if lstsq else ()) + (
+        ("structured", model.structure_key()) if STRUCTURED else ())
     key = P.key and fingerprint("kernels", P.key, law_code, optional_fingerprint(law_fn),
-                                *(("lstsq",) if lstsq else ()))  # fmt: skip
+                                *flags)  # fmt: skip
     tag(key, rhs)
     return Kernels(rhs, residual, energy, project, make_workspace, stack_workspace, n, m, k,
                    ng, key)
