@@ -32,6 +32,7 @@ CONFIGS = [
     ("andrews", "dop853", 1e3, 1e-4, 0.006, 2000),
     ("slider_crank", "rk4", 100.0, 1e-4, 0.2, 4000),
     ("double_pendulum", "midpoint", 10.0, 1e-3, 2.0, 10000),
+    ("double_pendulum", "dop853", 10.0, 0.02, 2.0, 10000),
     ("spherical_pendulum", "rk4", 10.0, 1e-3, 2.0, 4000),
     ("pendulum", "dop853", 10.0, 0.02, 10.0, 10000),  # diagonal mass: the width alone
 ]
