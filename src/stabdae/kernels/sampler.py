@@ -2,11 +2,14 @@
 
 From the consistent reference state ``x*`` (``g(x*) = 0``) each member is displaced by the
 minimum-norm step ``x⁰ = x* + G⁺α⁰``, ``G = ∂g/∂x`` ((2m + k) × 2n), ``G⁺ = Gᵀ(GGᵀ)⁻¹``
-(the paper's (2.9) idea), then corrected by Gauss–Newton steps ``x ← x + G⁺(α⁰ − g(x))``
-until ``g(x⁰) = α⁰``.  ``G`` is formed by central differences of the compiled residual;
-an approximate Jacobian changes the path, not the target, since the residual itself is
-exact.  Random numbers come from a seeded ``numpy.random.Generator`` in Python and enter
-the compiled code as arrays, so the result does not depend on the thread count.
+(the paper's (2.9) idea), then corrected by steps ``x ← x + G⁺(α⁰ − g(x))`` until
+``g(x⁰) = α⁰``: with ``G`` at ``x*`` (formed once for every member) while each step at
+least quarters the error, which for small α⁰ takes a step or two, and with ``G`` at the
+current state (Gauss–Newton) from the first step that does not.  ``G`` is formed by
+central differences of the compiled residual; an approximate Jacobian changes the path,
+not the target, since the residual itself is exact.  Random numbers come from a seeded
+``numpy.random.Generator`` in Python and enter the compiled code as arrays, so the result
+does not depend on the thread count.
 """
 
 from __future__ import annotations
@@ -62,13 +65,41 @@ def build_sampler(K):
     eps3 = np.finfo(np.float64).eps ** (1.0 / 3.0)
     eps = np.finfo(np.float64).eps
 
+    @njit(error_model="numpy")
+    def jacobian(x, t0, p, ws, xp, gpm, G, GGt):
+        """``G = ∂g/∂x`` at ``x`` by central differences and the L D Lᵀ factor of
+        ``G Gᵀ`` into ``GGt``; whether the factorization failed."""
+        for l in range(N2):
+            h = eps3 * max(1.0, abs(x[l]))
+            for k in range(N2):
+                xp[k] = x[k]
+            xp[l] = x[l] + h
+            residual(t0, xp, p, ws, gpm[0])
+            xp[l] = x[l] - h
+            residual(t0, xp, p, ws, gpm[1])
+            for i in range(ng):
+                G[i, l] = (gpm[0, i] - gpm[1, i]) / (2.0 * h)
+        for i in range(ng):
+            for k in range(i + 1):
+                s = 0.0
+                for l in range(N2):
+                    s += G[i, l] * G[k, l]
+                GGt[i, k] = s
+        return ldl_inplace(GGt, ng, 1e-14) != 0
+
     @njit(inline="always")
-    def place(x_start, t0, p, alpha, newton, ws, G, GGt, r, y, xp, gp, gpm, x):
-        """Place one member from ``x_start``; returns its status, with ``gp = g(x)`` at
-        the state ``x`` it leaves (without ``newton``: ``x_start`` itself, evaluated).
-        (The residual is called from three places only, the state's and the two
-        differences': each call is compiled inline, and two more were a tenth of a new
-        model's sampler compilation.)"""
+    def place(x_start, t0, p, alpha, newton, ws, G0, GGt0, bad0, G, GGt, r, y, xp, gp, gpm,
+              x):  # fmt: skip
+        """Place one member from ``x_start`` (the reference state, whose Jacobian ``G0``
+        and factor ``GGt0`` are given, ``bad0`` when that factorization failed); returns
+        its status, with ``gp = g(x)`` at the state ``x`` it leaves (without ``newton``:
+        ``x_start`` itself, evaluated).  The steps use the reference state's Jacobian
+        (the same for every member: the first step is the minimum-norm one) while each
+        at least quarters the error, then the Jacobian at the current state (Gauss–Newton
+        proper) at every step.
+        (The residual is called from one place here and two in :func:`jacobian`: each
+        call is compiled inline, and more were a tenth of a new model's sampler
+        compilation.)"""
         for l in range(N2):
             x[l] = x_start[l]
         amax = 0.0
@@ -76,6 +107,8 @@ def build_sampler(K):
             for i in range(ng):
                 amax = max(amax, abs(alpha[i]))
         stalled = False  # the last step was roundoff-limited
+        own = False  # Jacobian at the current state (else the reference state's)
+        prev = math.inf
         xnorm = 0.0
         it = 0
         while True:
@@ -95,34 +128,25 @@ def build_sampler(K):
             if it == MAX_NEWTON:
                 return _FAILED
             it += 1
-            # G = ∂g/∂x by central differences
-            for l in range(N2):
-                h = eps3 * max(1.0, abs(x[l]))
-                for k in range(N2):
-                    xp[k] = x[k]
-                xp[l] = x[l] + h
-                residual(t0, xp, p, ws, gpm[0])
-                xp[l] = x[l] - h
-                residual(t0, xp, p, ws, gpm[1])
-                for i in range(ng):
-                    G[i, l] = (gpm[0, i] - gpm[1, i]) / (2.0 * h)
-            for i in range(ng):
-                for k in range(i + 1):
-                    s = 0.0
-                    for l in range(N2):
-                        s += G[i, l] * G[k, l]
-                    GGt[i, k] = s
-            if ldl_inplace(GGt, ng, 1e-14) != 0:
+            if not own and err > 0.25 * prev:  # the fixed Jacobian converges too slowly
+                own = True
+            prev = err
+            if own:
+                if jacobian(x, t0, p, ws, xp, gpm, G, GGt):
+                    return _FAILED
+            elif bad0:
                 return _FAILED
+            Gu = G if own else G0
+            Fu = GGt if own else GGt0
             for i in range(ng):
                 y[i] = r[i]
-            ldl_solve_inplace(GGt, ng, y)
+            ldl_solve_inplace(Fu, ng, y)
             step = 0.0
             xnorm = 0.0
             for l in range(N2):
                 s = 0.0
                 for i in range(ng):
-                    s += G[i, l] * y[i]
+                    s += Gu[i, l] * y[i]
                 x[l] += s
                 step = max(step, abs(s))
                 xnorm = max(xnorm, abs(x[l]))
@@ -138,6 +162,8 @@ def build_sampler(K):
         for c in range(c_lo, c_hi):
             ws = make_workspace()
             nn = ng if newton else 0  # (the Newton steps' matrices: none to evaluate)
+            G0 = np.empty((nn, N2))
+            GGt0 = np.empty((nn, nn))
             G = np.empty((nn, N2))
             GGt = np.empty((nn, nn))
             r = np.empty(ng)
@@ -146,10 +172,15 @@ def build_sampler(K):
             gp = np.empty(ng)
             gpm = np.empty((2, ng))
             x = np.empty(N2)
+            bad0 = False
+            if newton:  # the reference state's Jacobian, shared by the chunk's members
+                for l in range(N2):
+                    x[l] = x_ref[l]
+                bad0 = jacobian(x, t0, p, ws, xp, gpm, G0, GGt0)
             for j in range(c * CHUNK, min(M, (c + 1) * CHUNK)):
                 x_start = x_ref if newton else x_out[j]
-                status[j] = place(x_start, t0, p, alphas[j], newton, ws, G, GGt, r, y, xp, gp,
-                                  gpm, x)  # fmt: skip
+                status[j] = place(x_start, t0, p, alphas[j], newton, ws, G0, GGt0, bad0, G,
+                                  GGt, r, y, xp, gp, gpm, x)  # fmt: skip
                 if newton:
                     for l in range(N2):
                         x_out[j, l] = x[l]
@@ -157,7 +188,7 @@ def build_sampler(K):
                     alpha_out[j, i] = gp[i]
 
     key = kernel_key(K.key, "sample")
-    tag(key, place)
+    tag(key, place, jacobian)
     return keyed_cache(sample_kernel, key)
 
 
