@@ -12,7 +12,9 @@ given radii, seed 0), integrated under the Baumgarte law (ω, ξ = 1) to ``t_end
   the end), every thread: fixed steps with ``midpoint``, ``rk4``, ``dopri5`` and
   ``dop853`` over a ladder of steps, and adaptive steps with the pairs Dormand–Prince
   5(4) and DOP853 over a ladder of tolerances (``atol = rtol``); and fixed-step DOP853
-  again on one thread (cost per core against thread count);
+  again on one thread (cost per core against thread count), and once more on one thread
+  from the sampled states given as ``x0`` (as the peers get them: no sampling and no
+  reference trajectory; the residual's decay is still measured);
 * heyoka's batch mode (``heyoka.taylor_adaptive_batch``, one member per SIMD lane, each
   lane with its own step), on the same stabilized ODE built from the scene's sympy spec
   (``kernels/specs``): M, γ, F and F's acceleration term derived by ``stabdae.symbolic``,
@@ -452,6 +454,14 @@ def run_scene(scene: Scene, members: int, repeat: int, quick: bool, diffrax_memb
             ds, wall = best_time(partial(stabdae_run, "dop853", steps=steps, threads=1), repeat)
             record("stabdae", "dop853 fixed, 1 thread", scene.t_end / steps,
                    ds["x_final"].values, wall, 1)  # fmt: skip
+    # the same on the states given (x0=, as heyoka and diffrax get them): no sampling and
+    # no reference trajectory, the decay measurement still made
+    for steps in ladder(scene.fixed["dop853"]):
+        run = partial(stabdae.ensemble, model, law, "dop853", scene.t_end / steps, scene.t_end,
+                      x0=x0, traces=0, states=True, save_dt=scene.t_end, threads=1)
+        ds, wall = best_time(run, repeat)
+        record("stabdae", "dop853 fixed, 1 thread, given states", scene.t_end / steps,
+               ds["x_final"].values, wall, 1)  # fmt: skip
     for batch in heyoka_batches():
         hy_b = Heyoka(system, x0, scene.t_end, batch)
         for tol in ladder(scene.heyoka_tols):
