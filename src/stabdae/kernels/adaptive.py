@@ -25,6 +25,7 @@ from numba import njit
 from .._status import Status
 from .cache import kernel_key, keyed_cache, memo, tag
 from .decay import begin, finish, ladders, observe, predict, scratch
+from .ensemble import UNROLL_MAX_TERMS
 from .rhs import kernels_for
 from .steps import sample_writer
 
@@ -321,33 +322,46 @@ def _pattern(pair) -> tuple:
             tuple(nz(row) for row in pair.error))  # fmt: skip
 
 
-def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple) -> str:
+def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple,
+                    n2: int | None = None) -> str:  # fmt: skip
     """Python source of one lane's attempted step of an embedded pair with ``s`` stages
     and error weights over ``s_e`` stages (``s + 1``: ẋ at the new state evaluated too),
     the stages written out (no inner loop around the inlined right-hand sides, so the lane
     loop around it vectorizes).  The sums run over the coefficients that are not zero
     (``pattern``, :func:`_pattern`), in the order of :func:`_adaptive_loop`'s loops, which
     skip the same zeros, so that each lane's numbers are those of the single-trajectory
-    loop bit for bit.  (With DOP853's zeros in, LLVM left the lane loop scalar.)  Every
-    stage is evaluated (lanes do not branch); ``nev`` counts those the single loop
-    evaluates (up to the first failing one).
+    loop bit for bit.  (With DOP853's zeros in, LLVM left the lane loop scalar.)  With the
+    state's size ``n2`` given, the loops over the state are written out per component
+    too while ``n2`` times the stages is at most ``UNROLL_MAX_TERMS``, as in the fixed-step
+    kernel (Andrews' 14 components with DOP853: LLVM did not unroll the loops, and the lane
+    loop ran scalar), in the same order.  Every stage is evaluated (lanes do not branch);
+    ``nev`` counts those the single loop evaluates (up to the first failing one).
     Returns ``(good, nev, err, r)``: all evaluations succeeded and the new state and the
     error norm are finite; the error norm; ``‖g‖∞`` at the last evaluation (the new
     state)."""
     a_nz, b_nz, e_nz = pattern
+    unrolled = n2 is not None and n2 * s_e <= UNROLL_MAX_TERMS
+
+    def over_state(body):  # a loop over l, or its body once per component
+        if not unrolled:
+            return ["    for l in range(N2):"] + [f"        {line}" for line in body]
+        return [f"    {line.replace('[l]', f'[{c}]')}" for c in range(n2) for line in body]
+
     lines = ["def attempt(t, hh, x, k0, p, law_mat, law_scal, tab_a, tab_b, tab_e, tab_c, rtol,",
              "            atol, ws, xs, xn, kl):"]
     lines += [f"    k{i} = stack1(N2)" for i in range(1, s_e)]
     lines += ["    ok = True", "    nev = 0"]
     for i in range(1, s):
-        lines += ["    for l in range(N2):", "        acc = 0.0"]
-        lines += [f"        acc += tab_a[{i}, {m}] * k{m}[l]" for m in range(i) if a_nz[i][m]]
-        lines += ["        xs[l] = x[l] + hh * acc",
-                  f"    c = rhs(t + tab_c[{i}] * hh, xs, p, law_mat, law_scal, ws, k{i})",
+        lines += over_state(["acc = 0.0"]
+                            + [f"acc += tab_a[{i}, {m}] * k{m}[l]" for m in range(i)
+                               if a_nz[i][m]]
+                            + ["xs[l] = x[l] + hh * acc"])  # fmt: skip
+        lines += [f"    c = rhs(t + tab_c[{i}] * hh, xs, p, law_mat, law_scal, ws, k{i})",
                   "    nev += ok", "    ok &= c == 0"]  # fmt: skip
-    lines += ["    fin = True", "    for l in range(N2):", "        acc = 0.0"]
-    lines += [f"        acc += tab_b[{i}] * k{i}[l]" for i in range(s) if b_nz[i]]
-    lines += ["        xn[l] = x[l] + hh * acc", "        fin &= math.isfinite(xn[l])"]
+    lines += ["    fin = True"]
+    lines += over_state(["acc = 0.0"]
+                        + [f"acc += tab_b[{i}] * k{i}[l]" for i in range(s) if b_nz[i]]
+                        + ["xn[l] = x[l] + hh * acc", "fin &= math.isfinite(xn[l])"])
     if s_e > s:
         lines += [f"    c = rhs(t + hh, xn, p, law_mat, law_scal, ws, k{s})",
                   "    nev += ok & fin", "    ok &= c == 0"]  # fmt: skip
@@ -355,28 +369,48 @@ def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple) -> str:
     # estimates in it is too large for LLVM to unroll at n = 4 (the double pendulum), and
     # the lane loop around a loop left rolled stays scalar.  Each sum still runs over l
     # in order, as the single loop's.
-    lines += ["    sc = stack1(N2)", "    for l in range(N2):",
-              "        sc[l] = atol + rtol * max(abs(x[l]), abs(xn[l]))",
-              "    s5 = 0.0", "    for l in range(N2):", "        acc5 = 0.0"]  # fmt: skip
-    lines += [f"        acc5 += tab_e[0, {i}] * k{i}[l]" for i in range(s_e) if e_nz[0][i]]
+    lines += ["    sc = stack1(N2)"]
+    lines += over_state(["sc[l] = atol + rtol * max(abs(x[l]), abs(xn[l]))"])
+    lines += ["    s5 = 0.0"]
+    est5 = ["acc5 = 0.0"] + [f"acc5 += tab_e[0, {i}] * k{i}[l]" for i in range(s_e)
+                             if e_nz[0][i]]  # fmt: skip
     if combined:
-        lines += ["        e5 = acc5 / sc[l]", "        s5 += e5 * e5",
-                  "    s3 = 0.0", "    for l in range(N2):", "        acc3 = 0.0"]  # fmt: skip
-        lines += [f"        acc3 += tab_e[1, {i}] * k{i}[l]" for i in range(s_e) if e_nz[1][i]]
-        lines += ["        e3 = acc3 / sc[l]", "        s3 += e3 * e3",
-                  "    e = combined_norm(s5, s3, hh, N2)"]  # fmt: skip
+        lines += over_state(est5 + ["e5 = acc5 / sc[l]", "s5 += e5 * e5"])
+        lines += ["    s3 = 0.0"]
+        lines += over_state(["acc3 = 0.0"]
+                            + [f"acc3 += tab_e[1, {i}] * k{i}[l]" for i in range(s_e)
+                               if e_nz[1][i]]
+                            + ["e3 = acc3 / sc[l]", "s3 += e3 * e3"])  # fmt: skip
+        lines += ["    e = combined_norm(s5, s3, hh, N2)"]
     else:
-        lines += ["        e5 = hh * acc5 / sc[l]", "        s5 += e5 * e5",
-                  "    e = math.sqrt(s5 / N2)"]  # fmt: skip
-    lines += ["    for l in range(N2):", f"        kl[l] = k{s_e - 1}[l]",
-              "    r = 0.0", "    for l in range(NG):", "        r = max(r, abs(ws.g[l]))",
+        lines += over_state(est5 + ["e5 = hh * acc5 / sc[l]", "s5 += e5 * e5"])
+        lines += ["    e = math.sqrt(s5 / N2)"]
+    lines += over_state([f"kl[l] = k{s_e - 1}[l]"])
+    lines += ["    r = 0.0", "    for l in range(NG):", "        r = max(r, abs(ws.g[l]))",
               "    return ok & fin & math.isfinite(e), nev, e, r"]  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
+def _label(s, s_e, combined, pattern) -> str:
+    return f"{s}-{s_e}-{int(combined)}-{hashlib.sha1(repr(pattern).encode()).hexdigest()[:10]}"
+
+
+def attempt_for(rhs, s: int, s_e: int, combined: bool, pattern: tuple, N2: int, ng: int):
+    """The compiled attempt of :func:`_attempt_source` on the right-hand side ``rhs`` of
+    a model with ``N2`` state components and ``ng`` residual components (marked
+    ``alwaysinline``: the block kernel's lane loop inlines it)."""
+    from .source import exec_source
+    from .workspace import stack1
+
+    ns = exec_source(_attempt_source(s, s_e, combined, pattern, N2),
+                     f"adaptive_attempt_{_label(s, s_e, combined, pattern)}",
+                     {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": ng, "math": math,
+                      "combined_norm": _combined_norm})  # fmt: skip
+    return njit(forceinline=True, error_model="numpy")(ns["attempt"])
+
+
 def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B: int,
                           n_params: int, law_shape):  # fmt: skip
-    from .source import exec_source
     from .workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 
     rhs, residual, energy = K.rhs, K.residual, K.energy
@@ -384,11 +418,8 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
     N2, ng = 2 * K.n, K.ng
     NP = max(n_params, 1)
     LR, LC = law_shape
-    label = f"{s}-{s_e}-{int(combined)}-{hashlib.sha1(repr(pattern).encode()).hexdigest()[:10]}"
-    ns = exec_source(_attempt_source(s, s_e, combined, pattern), f"adaptive_attempt_{label}",
-                     {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": ng, "math": math,
-                      "combined_norm": _combined_norm})
-    attempt = njit(forceinline=True, error_model="numpy")(ns["attempt"])
+    label = _label(s, s_e, combined, pattern)
+    attempt = attempt_for(rhs, s, s_e, combined, pattern, N2, ng)
 
     f_eval = _f_eval(rhs)
     first_step = _first_step(f_eval, N2)
