@@ -170,6 +170,17 @@ def test_identity_mass_compiles_no_factorization(monkeypatch):
     assert _divisions(explicit) == 3
 
 
+def _arithmetic_counts(fn) -> tuple[int, int]:
+    """Arithmetic instructions (and fused multiply-adds) on vectors of doubles and on
+    scalar doubles in the LLVM IR of the compiled ``fn``."""
+    ir = "\n".join(fn.inspect_llvm().values())
+    vector = len(re.findall(r"= (?:fadd|fsub|fmul|fdiv|fneg)[a-z ]* <\d+ x double>", ir))
+    vector += len(re.findall(r"call[a-z ]* <\d+ x double> @llvm\.fma\.", ir))
+    scalar = len(re.findall(r"= (?:fadd|fsub|fmul|fdiv|fneg)[a-z ]* double ", ir))
+    scalar += len(re.findall(r"call[a-z ]* double @llvm\.fma\.f64", ir))
+    return vector, scalar
+
+
 @compiled_only
 def test_member_loop_of_a_dense_model_vectorizes(monkeypatch):
     """Andrews' mechanism (n = 7, dense 7 × 7 mass matrix, 6 constraints) takes the dense
@@ -224,11 +235,7 @@ def test_member_loop_of_a_dense_model_vectorizes(monkeypatch):
                np.asarray(scheme.A, float), np.asarray(scheme.b, float),
                np.asarray(scheme.c, float), code)  # fmt: skip
     assert (code == 0).all() and np.isfinite(X).all()
-    ir = "\n".join(block_step.inspect_llvm().values())
-    vector = len(re.findall(r"= (?:fadd|fsub|fmul|fdiv|fneg)[a-z ]* <\d+ x double>", ir))
-    vector += len(re.findall(r"call[a-z ]* <\d+ x double> @llvm\.fma\.", ir))
-    scalar = len(re.findall(r"= (?:fadd|fsub|fmul|fdiv|fneg)[a-z ]* double ", ir))
-    scalar += len(re.findall(r"call[a-z ]* double @llvm\.fma\.f64", ir))
+    vector, scalar = _arithmetic_counts(block_step)
     assert vector > 100 and vector > scalar, (vector, scalar)
 
 
@@ -294,11 +301,7 @@ def test_adaptive_lane_loop_of_a_dense_model_vectorizes(monkeypatch, pair):
           np.asarray(ep.scheme.A, float), np.asarray(ep.scheme.b, float), tab_e,
           np.asarray(ep.scheme.c, float), E)  # fmt: skip
     assert (E >= 0).all() and np.isfinite(X).all()
-    ir = "\n".join(lanes.inspect_llvm().values())
-    vector = len(re.findall(r"= (?:fadd|fsub|fmul|fdiv|fneg)[a-z ]* <\d+ x double>", ir))
-    vector += len(re.findall(r"call[a-z ]* <\d+ x double> @llvm\.fma\.", ir))
-    scalar = len(re.findall(r"= (?:fadd|fsub|fmul|fdiv|fneg)[a-z ]* double ", ir))
-    scalar += len(re.findall(r"call[a-z ]* double @llvm\.fma\.f64", ir))
+    vector, scalar = _arithmetic_counts(lanes)
     assert vector > 100 and vector > scalar, (vector, scalar)
 
 
