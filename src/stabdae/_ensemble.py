@@ -91,7 +91,7 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
     alpha0 : array (members, 2m + k)
         The achieved perturbation ``g(x⁰, t0)``.
     status : array (members,) of int8
-        ``Status.SAMPLING_FAILED`` where Gauss–Newton did not reach ``α⁰`` to
+        ``Status.SAMPLING_FAILED`` where the corrections did not reach ``α⁰`` to
         ``1e-12·‖α⁰‖∞`` (or to roundoff, for tiny ``α⁰``).
     """
     who = "sample_perturbations"
