@@ -322,25 +322,24 @@ def _pattern(pair) -> tuple:
             tuple(nz(row) for row in pair.error))  # fmt: skip
 
 
-def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple,
-                    n2: int | None = None) -> str:  # fmt: skip
+def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple, n2: int) -> str:
     """Python source of one lane's attempted step of an embedded pair with ``s`` stages
     and error weights over ``s_e`` stages (``s + 1``: ẋ at the new state evaluated too),
     the stages written out (no inner loop around the inlined right-hand sides, so the lane
     loop around it vectorizes).  The sums run over the coefficients that are not zero
     (``pattern``, :func:`_pattern`), in the order of :func:`_adaptive_loop`'s loops, which
     skip the same zeros, so that each lane's numbers are those of the single-trajectory
-    loop bit for bit.  (With DOP853's zeros in, LLVM left the lane loop scalar.)  With the
-    state's size ``n2`` given, the loops over the state are written out per component
-    too while ``n2`` times the stages is at most ``UNROLL_MAX_TERMS``, as in the fixed-step
-    kernel (Andrews' 14 components with DOP853: LLVM did not unroll the loops, and the lane
-    loop ran scalar), in the same order.  Every stage is evaluated (lanes do not branch);
+    loop bit for bit.  (With DOP853's zeros in, LLVM left the lane loop scalar.)  The loops
+    over the state's ``n2`` components are written out too while ``n2`` times the stages
+    is at most ``UNROLL_MAX_TERMS``, as in the fixed-step kernel (Andrews' 14 components
+    with DOP853: LLVM did not unroll the loops, and the lane loop ran scalar), in the same
+    order.  Every stage is evaluated (lanes do not branch);
     ``nev`` counts those the single loop evaluates (up to the first failing one).
     Returns ``(good, nev, err, r)``: all evaluations succeeded and the new state and the
     error norm are finite; the error norm; ``‖g‖∞`` at the last evaluation (the new
     state)."""
     a_nz, b_nz, e_nz = pattern
-    unrolled = n2 is not None and n2 * s_e <= UNROLL_MAX_TERMS
+    unrolled = n2 * s_e <= UNROLL_MAX_TERMS
 
     def over_state(body):  # a loop over l, or its body once per component
         if not unrolled:

@@ -38,6 +38,7 @@ from numba import njit
 
 from .fma import fma
 from .source import exec_source
+from .sparsity import fill_pattern
 
 #: the routines are written out when they take at most this many multiply-adds (a model of
 #: n = 7 coordinates and 6 constraints: 294 for ``M⁻¹ Fᵀ``); larger ones keep their loops,
@@ -279,8 +280,6 @@ def _pattern(n: int, pattern) -> tuple:
     included, closed under the fill of the elimination): every entry for ``None``."""
     if pattern is None:
         return tuple(tuple(p <= j for p in range(n)) for j in range(n))
-    from .sparsity import fill_pattern
-
     fill = fill_pattern(np.asarray(pattern, dtype=bool)[:n, :n])
     return tuple(tuple(bool(fill[j, p]) for p in range(n)) for j in range(n))
 
@@ -358,10 +357,9 @@ def ldl_factor_for(n: int, pattern=None):
     structural non-zeros; their lower triangle and its fill are factored, the other
     entries are neither read nor written, and the code is written out whatever its size
     (the caller bounds it with :func:`factor_ops`)."""
-    L = _pattern(n, pattern)
     if pattern is None and n * n * n // 6 > UNROLL_MAX_OPS:
         return ldl_inplace
-    return _written_out("def ldl_factor(a, n, rtol):", _factor_lines(n, L)[0],
+    return _written_out("def ldl_factor(a, n, rtol):", _factor_lines(n, _pattern(n, pattern))[0],
                         _label(f"ldl_factor_{n}", pattern))  # fmt: skip
 
 

@@ -397,14 +397,13 @@ def _structured(model: Model, n: int, m: int, k: int) -> SimpleNamespace | None:
     if k:
         F[m:] = pats["h_v"]
     has_mass = "mass" in model.functions
-    M = np.asarray(pats["mass"], dtype=bool) if has_mass else None
+    M = np.tril(pats["mass"]) if has_mass else None  # the factor reads the lower triangle
     if has_mass:
-        Ypat, y_ops = solve_pattern(np.tril(M), F.T)
-        m_ops = factor_ops(n, np.tril(M))
+        Ypat, y_ops = solve_pattern(M, F.T)
+        m_ops = factor_ops(n, M)
     else:
         Ypat, y_ops, m_ops = F.T.copy(), 0, 0
-    Sfull = (F.astype(np.int64) @ Ypat.astype(np.int64)) > 0
-    S = np.tril(Sfull)
+    S = np.tril((F.astype(np.int64) @ Ypat.astype(np.int64)) > 0)
     gram_ops = int(sum((F[i] & Ypat[:, c]).sum() for i in range(r) for c in range(i + 1)))
     s_ops = factor_ops(r, S)
     ops = (m_ops, y_ops, gram_ops, s_ops)
@@ -435,12 +434,11 @@ def _structured(model: Model, n: int, m: int, k: int) -> SimpleNamespace | None:
         accel += [f"s = fma(Y[{j}, {i}], rl[{i}], s)" for i in range(r) if Ypat[j, i]]
         accel += [f"xdot[{j}] = v[{j}]", f"xdot[{n + j}] = s"]
     tag_ = model.structure_key()[:8]
+    mkey = _nested(M) if has_mass else None
     return SimpleNamespace(
-        ops=ops,
-        factor_M=ldl_factor_for(n, _nested(np.tril(M))) if has_mass else None,
-        solve_M=ldl_solve_for(n, _nested(np.tril(M))) if has_mass else None,
-        solve_columns_M=(ldl_solve_columns_for(n, r, _nested(np.tril(M)), _nested(F.T))
-                         if has_mass else None),  # fmt: skip
+        factor_M=ldl_factor_for(n, mkey) if has_mass else None,
+        solve_M=ldl_solve_for(n, mkey) if has_mass else None,
+        solve_columns_M=ldl_solve_columns_for(n, r, mkey, _nested(F.T)) if has_mass else None,
         factor_S=ldl_factor_for(r, _nested(S)),
         solve_S=ldl_solve_for(r, _nested(S)),
         load_Ft=_written_out("def load_Ft(fq, hv, Y):", load, f"load_Ft_{tag_}"),
