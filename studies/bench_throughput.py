@@ -12,7 +12,7 @@ Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored e
   vectorized by gcc), both OpenMP-parallel (``studies/bench_c/pendulum_rk2.c``); the blocked
   form also with ``-ffp-contract=off`` (no fused multiply-adds at all; gcc's default fuses
   wherever it likes, stabdae fuses its own multiply-adds explicitly, not the user's
-  expressions, see ``stabdae.kernels.fma``);
+  expressions, see ``stabdae.engine.fma``);
 * NumPy vectorized over members;
 * JAX ``lax.scan`` + ``vmap`` when jax is installed.
 
@@ -93,7 +93,7 @@ def run_kernel(model, law, x0, divergence, nsteps):
     from stabdae import _ensemble as E
     from stabdae._laws import bind_law
     from stabdae._schemes import as_scheme
-    from stabdae.kernels.ensemble import BLOCK
+    from stabdae.engine.ensemble.block import BLOCK
 
     bound, scheme = bind_law(law, model), as_scheme("midpoint")
     p, t0, M = model.param_vector(None), model.t0, x0.shape[0]

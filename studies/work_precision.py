@@ -59,7 +59,7 @@ from scipy.integrate import DOP853, Radau
 import stabdae
 from stabdae._laws import bind_law
 from stabdae._schema import write_netcdf
-from stabdae.kernels.rhs import _noop4, _noop5, kernels_for
+from stabdae.engine.rhs import _noop4, _noop5, kernels_for
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

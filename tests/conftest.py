@@ -12,7 +12,7 @@ import pytest
 
 import stabdae
 from stabdae._schema import udunits_ok
-from stabdae.kernels.jit import JIT
+from stabdae.engine.jit import JIT
 
 #: tests that look at compiled code (signatures, LLVM IR, NRT allocations): skipped when
 #: the suite runs as Python with NUMBA_DISABLE_JIT=1
@@ -57,7 +57,7 @@ def rhs_function(model: stabdae.Model, law):
     """The stabilized right-hand side ``F(t, x)`` of ``model`` under ``law`` as a Python
     function (the compiled one, called directly), for tests against its definition."""
     from stabdae._laws import bind_law
-    from stabdae.kernels.rhs import kernels_for
+    from stabdae.engine.rhs import kernels_for
 
     bound = bind_law(law, model)
     K = kernels_for(model, bound)

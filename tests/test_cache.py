@@ -17,7 +17,7 @@ from numba import njit
 
 import stabdae
 from stabdae._loading import scene_dir
-from stabdae.kernels.cache import function_fingerprint
+from stabdae.engine.cache import function_fingerprint
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -26,8 +26,8 @@ CHILD = textwrap.dedent(
     import json, sys, time
     import numpy as np
     import stabdae
-    from stabdae.kernels.ensemble import ensemble_kernel_for
-    from stabdae.kernels.sampler import sampler_for
+    from stabdae.engine.ensemble.block import ensemble_kernel_for
+    from stabdae.engine.sampler import sampler_for
     from stabdae._laws import bind_law
     clock = time.perf_counter()
     model = stabdae.load_model(sys.argv[1])
@@ -94,7 +94,7 @@ def test_closures_are_told_apart_by_what_they_capture():
 
 @pytest.mark.parametrize("value", ["off", "0"])
 def test_cache_can_be_switched_off(monkeypatch, value):
-    from stabdae.kernels.cache import cache_dir, keyed_cache
+    from stabdae.engine.cache import cache_dir, keyed_cache
 
     monkeypatch.setenv("STABDAE_CACHE_DIR", value)
     assert cache_dir() is None
@@ -279,7 +279,7 @@ def test_a_truncated_cache_and_an_unusable_cache_folder_still_compile_and_run(mo
 
 
 def test_without_numbas_private_caching_api_kernels_compile_in_memory(monkeypatch):
-    from stabdae.kernels import cache as kc
+    from stabdae.engine import cache as kc
 
     monkeypatch.setattr(kc, "CACHING_API", False)
     monkeypatch.setattr(kc, "_WARNED", set())

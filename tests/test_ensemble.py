@@ -18,9 +18,9 @@ from numba import njit
 import stabdae
 from conftest import ROOT, assert_schema, load_scene
 from stabdae._schema import write_netcdf
-from stabdae.kernels import decay
-from stabdae.kernels.ensemble import CHECKPOINT
-from stabdae.kernels.fma import HOST_FMA
+from stabdae.engine import decay
+from stabdae.engine.ensemble.block import CHECKPOINT
+from stabdae.engine.fma import HOST_FMA
 
 # ω = 1000 with τω = 0.1: the residual decays over several decades before the truncation
 # floor, and the discrete rate −ln ρ(R(τÃ))/τ differs from the continuous ω (Euler: 5 %).
@@ -73,7 +73,7 @@ def test_sampling_reaches_the_targets(radius):
     x0, alpha0, status = stabdae.sample_perturbations(model, 200, radius, seed=5)
     assert (status == 0).all()
     rng = np.random.default_rng(5)  # the same draws, to get the targets back
-    from stabdae.kernels.sampler import draw_alphas
+    from stabdae.engine.sampler import draw_alphas
 
     targets = draw_alphas(model.n_residual, 200, radius, rng)
     err = np.max(np.abs(alpha0 - targets), axis=1)
@@ -548,7 +548,7 @@ def test_members_stopped_mid_run_keep_their_last_good_state():
 def test_measures_of_stored_traces_match_numpy():
     """Initial, largest and final norm of traces with stops (inf, NaN) are NumPy's over
     the leading finite samples; a stopped trace gets no β and the reason "stopped"."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     norms = np.random.default_rng(0).random((40, 30))
     norms[3, 10:] = np.nan
@@ -568,7 +568,7 @@ def test_ladder_records_are_the_right_envelope():
     those of them that no later sample exceeds (the right envelope), in time order."""
     import struct
 
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     rng = np.random.default_rng(4)
     v = np.exp(-np.linspace(0, 12, 700) + 2.0 * rng.standard_normal(700))
@@ -615,7 +615,7 @@ def test_map_gamma_is_the_largest_product_on_the_envelope():
         env = [i for i in above.values()
                if v[i] > 0 and (i == v.size - 1 or later_max[i + 1] < v[i])]  # fmt: skip
         for beta in (0.5, 2.0, 7.0):
-            gamma, t_end = decay._map_gamma(lt, lv, 0, lo, top, beta, u)
+            gamma, t_end = decay.onestep._map_gamma(lt, lv, 0, lo, top, beta, u)
             expect = max(v[i] * math.exp(beta * t[i]) for i in env)
             assert gamma == pytest.approx(expect, rel=1e-14), (lo, beta)
             assert t_end == max(t[i] for i in above.values())
@@ -698,7 +698,7 @@ def test_fitted_rate_of_exact_decays(c0):
     zero crossing before the window for c0 < 0), ``e^{−βt}`` and ``e^{−βt}`` times an
     oscillation, each on a floor of seeded noise: the true β within 1 %; γ the smallest
     prefactor of ``e^{−βt}`` over the transient."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     beta, c1 = 10.0, 10.0
     t = np.arange(4001) * 0.001  # the floor from t ≈ 2: the last fifth lies on it
@@ -724,7 +724,7 @@ def test_fitted_rate_of_exact_decays(c0):
 def test_refined_shift_gives_the_repeated_eigenvalue_rate(c0):
     """On ``|c0 + c1 t| e^{−βt}`` with a floor at 1e-13, the ``ν log(t + s)`` fit with its
     shift refined (Brent's method) recovers β to 0.2 %."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     t = np.arange(4001) * 0.001
     floor = 1e-13 * (1.0 + 0.5 * np.random.default_rng(2).random(t.size))
@@ -740,7 +740,7 @@ def test_log_normal_is_the_library_logarithm_to_an_ulp():
     exact at 1."""
     from numba import njit
 
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     @njit
     def logs(x, out):
@@ -764,14 +764,14 @@ def test_log_normal_is_the_library_logarithm_to_an_ulp():
 def test_log_prefactor_fit_recovers_an_exact_model(shift):
     """``log ‖g‖ = c − βt + ν log(t + s)`` sampled without noise: the fit at that shift
     returns its β to 1e-9 and a zero sum of squares."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     t = np.linspace(0.3, 1.5, 40)
     y = 0.7 - 9.5 * t + 1.0 * np.log(t + shift)
     rt, ry, a, b, lg = decay.scratch()
     rt[:40], ry[:40] = t, y
-    beta, sse = decay._fit_with_log(rt, ry, 0, 40, shift, a, b, lg,
-                                    decay._shift_free_sums(rt, ry, 0, 40))
+    beta, sse = decay.fit._fit_with_log(rt, ry, 0, 40, shift, a, b, lg,
+                                    decay.fit._shift_free_sums(rt, ry, 0, 40))
     assert abs(beta - 9.5) < 1e-9 and sse < 1e-20
 
 
@@ -780,14 +780,14 @@ def test_log_prefactor_search_from_a_hint_finds_the_grids_minimum(hint):
     """The prediction's shift search starts at the measured member's shift: from a hint
     near the true shift (2.0) it finds the exact model's β; from a hint far off (the
     minimum on its bracket's edge) it falls back to the whole grid, as with no hint."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     t = np.linspace(0.3, 1.5, 40)
     y = 0.7 - 9.5 * t + 1.0 * np.log(t + 2.0)
     rt, ry, a, b, lg = decay.scratch()
     rt[:40], ry[:40] = t, y
-    beta, sse, shift = decay._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg, hint)
-    grid = decay._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg)
+    beta, sse, shift = decay.fit._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg, hint)
+    grid = decay.fit._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg)
     assert abs(beta - 9.5) < 1e-6 and abs(shift - 2.0) < 1e-3
     assert abs(beta - grid[0]) < 1e-6
 
@@ -796,7 +796,7 @@ def test_envelope_logarithms_are_the_librarys():
     """The envelope's log norms (a vectorized logarithm over the row): within an ulp of
     numpy's on normal norms; a row with a zero norm (−inf) or one below the normal floats
     takes the library's log for every point."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     lt, lv, _ = decay.ladders(3)
     rt, ry = np.empty(decay.NBINS), np.empty(decay.NBINS)
@@ -822,14 +822,14 @@ def test_envelope_logarithms_are_the_librarys():
 def test_log_prefactor_fit_outside_the_normal_range_is_least_squares():
     """A shift that puts t + s below the normal floats (t from 0, s = 1e-310) takes the
     library's logarithm: the fit is then numpy's least squares on the same columns."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     t = np.linspace(0.0, 1.0, 30)
     y = 0.3 - 4.0 * t + 0.01 * np.sin(7.0 * t)
     rt, ry, a, b, lg = decay.scratch()
     rt[:30], ry[:30] = t, y
-    beta, sse = decay._fit_with_log(rt, ry, 0, 30, 1e-310, a, b, lg,
-                                    decay._shift_free_sums(rt, ry, 0, 30))
+    beta, sse = decay.fit._fit_with_log(rt, ry, 0, 30, 1e-310, a, b, lg,
+                                    decay.fit._shift_free_sums(rt, ry, 0, 30))
     X = np.column_stack([np.ones(30), -t, np.log(t + 1e-310)])
     coef, res = np.linalg.lstsq(X, y, rcond=None)[:2]
     assert abs(beta - coef[1]) < 1e-9 * abs(coef[1])
@@ -839,7 +839,7 @@ def test_log_prefactor_fit_outside_the_normal_range_is_least_squares():
 def test_no_transient_or_growth_gives_no_rate_and_says_why():
     """A trace that sits on its floor, and one that grows, get β = NaN with their
     reasons, never a fitted number."""
-    from stabdae.kernels import decay
+    from stabdae.engine import decay
 
     t = np.arange(2001) * 1e-3
     flat = 1e-6 * (1.0 + 0.5 * np.random.default_rng(3).random(t.size))

@@ -13,8 +13,8 @@ import stabdae
 from conftest import assert_schema, compiled_only, load_scene, perturbed_state
 from stabdae._laws import bind_law
 from stabdae._schema import write_netcdf
-from stabdae.kernels.rhs import kernels_for
-from stabdae.kernels.steps import integrator_for, stepper_for
+from stabdae.engine.rhs import kernels_for
+from stabdae.engine.rk.steps import integrator_for, stepper_for
 from toy import X_REF, unit_pendulum
 
 
@@ -191,8 +191,9 @@ def test_member_loop_of_a_dense_model_vectorizes(monkeypatch):
     innermost and ran scalar: 49 vector arithmetic instructions against 917 scalar ones;
     written out, 1098 against 62.)"""
     from stabdae._schemes import as_scheme
-    from stabdae.kernels.ensemble import BLOCK, _member_step, tableau_pattern
-    from stabdae.kernels.workspace import copy_inputs, stack1, stack2
+    from stabdae.engine.ensemble.block import BLOCK
+    from stabdae.engine.rk.steps import _member_step, tableau_pattern
+    from stabdae.engine.workspace import copy_inputs, stack1, stack2
 
     monkeypatch.setenv("STABDAE_CACHE_DIR", "off")
     model = load_scene("andrews")
@@ -248,8 +249,9 @@ def test_adaptive_lane_loop_of_a_dense_model_vectorizes(monkeypatch, pair):
     LLVM did not unroll them and the lane loop ran scalar: Andrews' DOP853 ensemble at
     rtol 1e-5 cost 911 core-µs per member, 143 written out, the same bits.)"""
     from stabdae._schemes import embedded_pair
-    from stabdae.kernels.adaptive import LANES, _pattern, attempt_for
-    from stabdae.kernels.workspace import copy_inputs, copy_tableau, stack1, stack2
+    from stabdae.engine.ensemble.lanes import LANES
+    from stabdae.engine.rk.adaptive import _pattern, attempt_for
+    from stabdae.engine.workspace import copy_inputs, copy_tableau, stack1, stack2
 
     monkeypatch.setenv("STABDAE_CACHE_DIR", "off")
     model = load_scene("andrews")

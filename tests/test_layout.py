@@ -4,6 +4,7 @@ workspace and its debuggability (generated source, running without the JIT)."""
 from __future__ import annotations
 
 import ast
+import importlib
 import inspect
 import os
 import subprocess
@@ -20,9 +21,10 @@ from conftest import ROOT, assert_schema, compiled_only, load_scene
 from stabdae import theory
 from stabdae._laws import bind_law
 from stabdae._schema import schema_markdown, udunits_ok
-from stabdae.kernels.ensemble import _member_step_source, ensemble_kernel_for, tableau_pattern
-from stabdae.kernels.rhs import kernels_for
-from stabdae.kernels.workspace import LAYOUT, shapes
+from stabdae.engine.ensemble.block import ensemble_kernel_for
+from stabdae.engine.rhs import kernels_for
+from stabdae.engine.rk.steps import _member_step_source, tableau_pattern
+from stabdae.engine.workspace import LAYOUT, shapes
 
 SRC = ROOT / "src" / "stabdae"
 
@@ -106,17 +108,17 @@ def test_theory_is_a_leaf():
     drivers = {"stabdae._integrate", "stabdae._adaptive", "stabdae._ensemble"}
     assert not reached & drivers, reached & drivers
     assert not any(m.startswith("stabdae.study") for m in reached), reached
-    integrating = ("stabdae.kernels.steps", "stabdae.kernels.ensemble", "stabdae.kernels.adaptive")
+    integrating = ("stabdae.engine.rk", "stabdae.engine.ensemble")
     assert not any(m.startswith(integrating) for m in reached), reached
 
 
-def test_kernels_floor_imports_nothing_above_it():
+def test_engine_floor_imports_nothing_above_it():
     """The compiled floor imports no xarray, no validation, no driver and no study module:
     only itself and the status codes."""
-    for path in (SRC / "kernels").rglob("*.py"):
+    for path in (SRC / "engine").rglob("*.py"):
         deps = _imports(path)
         assert "xarray" not in deps, path.name
-        above = {d for d in deps if d in _MODULES and not d.startswith("stabdae.kernels")}
+        above = {d for d in deps if d in _MODULES and not d.startswith("stabdae.engine")}
         assert above <= {"stabdae._status", "stabdae._laws", "stabdae._model"}, (path.name,
                                                                                  above)
         # the law and model modules only under TYPE_CHECKING (skipped above): none at run
@@ -327,7 +329,7 @@ def test_generated_member_step_is_visible_and_can_be_dumped(tmp_path, monkeypatc
     source = _member_step_source(tableau_pattern(scheme), 4)  # the pendulum's 2n = 4
     dumped = [p.read_text() for p in tmp_path.glob("member_step_*.py")]
     assert source in dumped
-    from stabdae.kernels.ensemble import _member_step
+    from stabdae.engine.rk.steps import _member_step
 
     step = _member_step(lambda *a: 0, 4, 2, tableau_pattern(scheme))
     assert inspect.getsource(step.py_func) == source
@@ -344,3 +346,16 @@ def test_trajectory_tests_pass_without_the_jit():
                           text=True, timeout=900)  # fmt: skip
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
     assert " passed" in proc.stdout and "failed" not in proc.stdout
+
+
+def test_engine_init_and_architecture_list_every_module():
+    """A contributor finds every room of the compiled floor from its ``__init__`` and from
+    the architecture page: a module added, moved or removed without them fails here."""
+    engine = SRC / "engine"
+    modules = sorted(".".join(p.relative_to(engine).with_suffix("").parts)
+                     for p in engine.rglob("*.py") if p.name != "__init__.py")  # fmt: skip
+    listed = importlib.import_module("stabdae.engine").__doc__
+    page = (ROOT / "docs" / "architecture.md").read_text()
+    for mod in modules:
+        assert f":mod:`.{mod}`" in listed, f"stabdae.engine's docstring does not list {mod}"
+        assert f"`{mod}`" in page, f"docs/architecture.md does not list engine.{mod}"

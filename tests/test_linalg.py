@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stabdae.kernels.linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
+from stabdae.engine.linalg import ldl_inplace, ldl_solve_columns, ldl_solve_inplace
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5, 8])
@@ -48,7 +48,7 @@ def test_singular_indefinite_and_nan_are_reported():
 @pytest.mark.parametrize("n,rank", [(1, 1), (3, 3), (4, 3), (5, 2), (6, 6)])
 def test_pinv_solve_sym_matches_numpy_pinv(n, rank):
     """The least-squares multiplier: S⁺b against numpy.linalg.pinv, full and deficient rank."""
-    from stabdae.kernels.linalg import pinv_solve_sym
+    from stabdae.engine.linalg import pinv_solve_sym
 
     rng = np.random.default_rng(n + rank)
     F = rng.standard_normal((n, rank)) @ rng.standard_normal((rank, n))
@@ -65,7 +65,7 @@ def test_fma_rounds_once_where_the_host_has_fma():
     1 + 2⁻²⁹ and gives 0.  Without FMA hardware ``fma`` is that multiply-then-add."""
     from numba import njit
 
-    from stabdae.kernels.fma import HOST_FMA, fma
+    from stabdae.engine.fma import HOST_FMA, fma
 
     @njit
     def f(a, b, c):
@@ -97,7 +97,7 @@ def test_written_out_routines_give_the_loops_numbers_bit_for_bit(n):
     (so that the ensemble kernel's member loop around them vectorizes) do the loops'
     operations in the loops' order: the same bits, the same failing pivot, the same
     untouched entries outside the leading block."""
-    from stabdae.kernels.linalg import (
+    from stabdae.engine.linalg import (
         UNROLL_MAX_OPS,
         ldl_factor_for,
         ldl_solve_columns_for,
@@ -141,7 +141,7 @@ def test_written_out_routines_give_the_loops_numbers_bit_for_bit(n):
 
 def test_written_out_routines_of_size_zero_do_nothing():
     """A model without holonomic constraints (m = 0) gets the solves of size 0."""
-    from stabdae.kernels.linalg import ldl_solve_columns_for, ldl_solve_for
+    from stabdae.engine.linalg import ldl_solve_columns_for, ldl_solve_for
 
     b = np.arange(3.0)
     ldl_solve_for(0)(np.eye(3), 0, b)
@@ -161,14 +161,14 @@ def test_written_out_routines_for_a_pattern_skip_its_zeros_only(shape):
     the sign of a zero on the factor's pattern (its fill included: an arrow matrix whose
     first row is full fills in completely), the entries off it neither read nor written,
     and the solution's non-zeros where :func:`solve_pattern` says."""
-    from stabdae.kernels.linalg import (
+    from stabdae.engine.linalg import (
         factor_ops,
         ldl_factor_for,
         ldl_solve_columns_for,
         ldl_solve_for,
         solve_pattern,
     )
-    from stabdae.kernels.sparsity import fill_pattern
+    from stabdae.engine.sparsity import fill_pattern
 
     n = 7
     if shape == "blocks":  # Andrews' mass matrix: pairs of coupled angles and a single one

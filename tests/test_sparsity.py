@@ -10,8 +10,8 @@ from numba import njit
 import stabdae
 from conftest import KERNELS, SCENES, load_scene, perturbed_state, scene_module
 from stabdae._laws import bind_law
-from stabdae.kernels.rhs import LAW_CONSTANT, LAW_SCALAR_BLOCKS, kernels_for
-from stabdae.kernels.sparsity import dense_cost, fill_pattern, sparse_cost, structure
+from stabdae.engine.rhs import LAW_CONSTANT, LAW_SCALAR_BLOCKS, kernels_for
+from stabdae.engine.sparsity import dense_cost, fill_pattern, sparse_cost, structure
 
 
 def _rhs_and_projection(model, law, x, t=0.05):
@@ -61,7 +61,7 @@ def test_written_out_structure_and_dense_loops_agree_on_every_scene(name):
     little to save), the dense path's linear algebra is written out without the model's
     structural zeros: the same numbers as the dense loops up to the sign of a zero, at
     states off the manifold."""
-    from stabdae.kernels.rhs import _structured
+    from stabdae.engine.rhs import _structured
 
     model = load_scene(name)
     plan = None if model.sparse_structure() is not None else _structured(
@@ -117,7 +117,7 @@ def test_law_kinds_share_the_pieces_no_law_touches():
     factors on the sparse path) use the same residual, projection and workspace, compiled
     once; each law kind has its own right-hand side; the least-squares multiplier, which
     stays dense, has its own pieces."""
-    from stabdae.kernels.sampler import _Unstabilized
+    from stabdae.engine.sampler import _Unstabilized
 
     model = stabdae.load_model(KERNELS / "fekete.py")
     run = kernels_for(model, bind_law(stabdae.baumgarte(10.0, 1.0), model))

@@ -18,7 +18,7 @@ from scipy.linalg import expm
 import stabdae
 from conftest import load_scene, perturbed_state
 from stabdae._laws import LawError, bind_law
-from stabdae.kernels.rhs import kernels_for
+from stabdae.engine.rhs import kernels_for
 from stabdae.theory import step_matrix
 
 

@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from stabdae.kernels.threads import run_chunks
+from stabdae.engine.threads import run_chunks
 
 
 def test_chunks_cover_every_item_once_and_report_progress():
@@ -59,7 +59,7 @@ def test_chunks_shrink_towards_the_end(items, threads):
     """Consecutive ranges over every item; none larger than an equal share of
     ``threads × 8`` chunks, and with more than one thread each at most half a thread's
     share of what is left (down to one item), so that the last ones are short."""
-    from stabdae.kernels.threads import _chunks
+    from stabdae.engine.threads import _chunks
 
     chunks = _chunks(items, threads)
     assert chunks[0][0] == 0 and chunks[-1][1] == items

@@ -4,7 +4,7 @@ numerical integration, after R. G. Mukharlyamov's constraint-perturbation equati
 The public API is exactly what this module re-exports, plus the submodules
 :mod:`stabdae.theory`, :mod:`stabdae.symbolic`, :mod:`stabdae.simdmath` and
 :mod:`stabdae.plots`.  The floors
-below it: :mod:`stabdae.kernels` (compiled), the drivers and definitions here,
+below it: :mod:`stabdae.engine` (compiled), the drivers and definitions here,
 :mod:`stabdae.study` (study files, runs, command line).
 """
 

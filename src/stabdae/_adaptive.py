@@ -1,7 +1,7 @@
 """Adaptive steps with an embedded pair (Dormand–Prince 5(4), DOP853) for one trajectory.
 
 For reference solutions and work–precision comparisons: the stabilized right-hand side
-(3.1), (3.11) integrated with local error control (the loop: :mod:`.kernels.adaptive`).
+(3.1), (3.11) integrated with local error control (the loop: :mod:`.engine.rk.adaptive`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from ._integrate import IntegrationWarning, _multipliers
 from ._model import Model
 from ._schema import trajectory_dataset
 from ._status import Status
-from .kernels.adaptive import adaptive_for
+from .engine.rk.adaptive import adaptive_for
 
 __all__ = ["integrate_adaptive"]
 

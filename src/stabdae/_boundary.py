@@ -33,7 +33,7 @@ from ._measures import (
     STAGES,
 )
 from ._schema import provenance, schema_variable, variable
-from .kernels.ensemble import BLOCK
+from .engine.ensemble.block import BLOCK
 
 __all__ = ["boundary", "floor_limit"]
 

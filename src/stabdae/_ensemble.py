@@ -2,9 +2,9 @@
 
 :func:`ensemble` is a thin driver: it validates its arguments (:mod:`._validate`), places
 the initial states (:func:`sample_perturbations`, the compiled sampler of
-:mod:`.kernels.sampler`), runs the block-lockstep kernel (:mod:`.kernels.ensemble`) or,
-with ``rtol``, the per-member adaptive kernel (:mod:`.kernels.adaptive`) over chunks of
-members on threads, each chunk's traces fitted (:mod:`.kernels.decay`) by the thread that
+:mod:`.engine.sampler`), runs the block-lockstep kernel (:mod:`.engine.ensemble.block`) or,
+with ``rtol``, the per-member adaptive kernel (:mod:`.engine.ensemble.lanes`) over chunks of
+members on threads, each chunk's traces fitted (:mod:`.engine.decay`) by the thread that
 integrated them, and builds the dataset (:mod:`._schema`) beside the theorems'
 predictions (:mod:`.theory`).
 """
@@ -27,17 +27,11 @@ from ._laws import Theorem5
 from ._model import Model
 from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_variable, variable
 from ._status import Status
-from .kernels import decay
-from .kernels.adaptive import LANES, adaptive_block_for
-from .kernels.ensemble import BLOCK, ensemble_kernel_for
-from .kernels.sampler import (
-    CHUNK,
-    SAMPLING_RTOL,
-    draw_alphas,
-    residual_rows_for,
-    sampler_for,
-)
-from .kernels.threads import default_threads, run_chunks
+from .engine import decay
+from .engine.ensemble.block import BLOCK, ensemble_kernel_for
+from .engine.ensemble.lanes import LANES, adaptive_block_for
+from .engine.sampler import CHUNK, SAMPLING_RTOL, draw_alphas, residual_rows_for, sampler_for
+from .engine.threads import default_threads, run_chunks
 
 __all__ = ["ensemble", "sample_perturbations"]
 
@@ -109,7 +103,7 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
 
 
 def _place(model, targets, p, t0, threads=None, beside=None):
-    """The members placed at the targets ``α⁰`` (:mod:`.kernels.sampler`):
+    """The members placed at the targets ``α⁰`` (:mod:`.engine.sampler`):
     ``(x0, alpha0, status)``.  With ``beside`` (a function of no arguments) the placing
     runs on a thread of its own while ``beside()`` runs on this one, and its result comes
     fourth: the ensemble's reference trajectory, whose first call for a new model compiles

@@ -11,7 +11,7 @@ from . import _validate as check
 from ._model import Model
 from ._schema import trajectory_dataset
 from ._status import Status
-from .kernels.steps import integrator_for, multipliers_for
+from .engine.rk.steps import integrator_for, multipliers_for
 
 __all__ = ["integrate", "IntegrationWarning"]
 

@@ -21,8 +21,8 @@ import numpy as np
 from numba.core.dispatcher import Dispatcher
 
 from ._model import Model, ModelError, probe_output
-from .kernels.jit import is_njit
-from .kernels.rhs import LAW_ACPR, LAW_CONSTANT, LAW_SCALAR_BLOCKS, LAW_THEOREM5, LAW_USER
+from .engine.jit import is_njit
+from .engine.rhs import LAW_ACPR, LAW_CONSTANT, LAW_SCALAR_BLOCKS, LAW_THEOREM5, LAW_USER
 
 __all__ = [
     "Law", "BoundLaw", "baumgarte", "matrix", "theorem5", "none", "user", "acpr", "as_law",

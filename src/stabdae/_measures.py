@@ -1,7 +1,7 @@
 """What an ensemble reports: each member's class with its reason, and the summaries with
 their uncertainty.
 
-Per member (from the measures of :mod:`.kernels.decay`: its initial norm, the largest norm
+Per member (from the measures of :mod:`.engine.decay`: its initial norm, the largest norm
 over each fifth of the run ``W0 … W4``, the floor ``W4``) a *stability class*:
 
 ``decayed``
@@ -36,7 +36,7 @@ import math
 import numpy as np
 
 from ._status import Status
-from .kernels import decay
+from .engine import decay
 
 #: class codes of ``stability_class``
 DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON, GROWING, DIVERGED, NOT_RUN = range(7)

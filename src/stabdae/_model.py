@@ -28,7 +28,7 @@ import numpy as np
 from numba.core.dispatcher import Dispatcher
 
 from ._check import check_model
-from .kernels.jit import is_njit, python_function
+from .engine.jit import is_njit, python_function
 
 __all__ = ["Model", "ModelError"]
 
@@ -538,13 +538,13 @@ class Model:
         return patterns
 
     def sparse_structure(self):
-        """The index lists of the sparse right-hand side (:mod:`stabdae.kernels.sparsity`),
+        """The index lists of the sparse right-hand side (:mod:`stabdae.engine.sparsity`),
         or None where the dense one is used: ``sparsity="dense"``, a mass matrix that is
         not diagonal, or (``sparsity="detect"`` or declared patterns) a structure that
         saves less than half the dense path's multiply-adds."""
         if self._structure is not _UNSET:
             return self._structure
-        from .kernels.sparsity import dense_cost, sparse_cost, structure
+        from .engine.sparsity import dense_cost, sparse_cost, structure
 
         st = None
         pats = self.patterns

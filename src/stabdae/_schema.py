@@ -31,8 +31,8 @@ from ._measures import CLASSES, STAGES, TAU_STAR_REASONS
 from ._status import Status, status_flag_attrs
 from ._vector_width import PREFER_512
 from ._version import __version__
-from .kernels.decay import KINDS, REASONS
-from .kernels.fma import HOST_FMA
+from .engine.decay import KINDS, REASONS
+from .engine.fma import HOST_FMA
 
 __all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "provenance",
            "schema_markdown", "schema_variable", "trajectory_dataset", "udunits_ok", "utc_now",
@@ -455,7 +455,7 @@ def provenance(model, p: np.ndarray | None, law, scheme, action: str, **run) -> 
         "model_m": model.m,
         "model_k": model.k,
         "model_param_names": " ".join(model.param_names),
-        # 1: the library's multiply-adds were fused (kernels.fma); results differ at
+        # 1: the library's multiply-adds were fused (engine.fma); results differ at
         # roundoff from a machine without FMA, which computes them with two roundings
         "fused_multiply_add": int(HOST_FMA),
         # 1: compiled for 512-bit SIMD vectors (the same bits as with 256: speed only)

@@ -19,7 +19,7 @@ import numpy as np
 from ._laws import Law, LawError, as_law, bind_law
 from ._model import Model, ModelError
 from ._schemes import EmbeddedPair, Scheme, SchemeError, as_scheme, embedded_pair
-from .kernels.rhs import LAW_ACPR, MULTIPLIERS, PROJECTIONS
+from .engine.rhs import LAW_ACPR, MULTIPLIERS, PROJECTIONS
 
 __all__ = [
     "block", "bound_law", "choice", "count", "dtype", "fixed_time_grid", "initial_state",

@@ -42,7 +42,7 @@ import math
 
 from numba import njit
 
-from .kernels.fma import fma
+from .engine.fma import fma
 
 __all__ = ["cos", "sin"]
 

@@ -603,6 +603,15 @@ def along_path(model: Model, law, scheme, trajectory: xr.Dataset, *, params=None
         The weight ``P`` of the norm (default: from the discrete Lyapunov equation of
         ``R_0``).
 
+    Returns
+    -------
+    xarray.Dataset
+        Per step: the spectral radius, the max-, 2- and weighted norm of ``R_k``, the
+        remainder and the residual norm; the scalars ``q``, ``epsilon`` and
+        ``bound_start``.
+
+    Notes
+    -----
     Per step ``k``: ``A_k = A(x_k)``; ``Ȧ_k`` by central differences along the path; ``R_k``
     (:func:`step_matrix`); its spectral radius, max-, 2- and weighted norm (``P`` from the
     discrete Lyapunov equation of ``R_0`` unless ``weight`` is given — one norm for the

@@ -4,7 +4,9 @@ Usage: ``python tests/mutation/run.py [--jobs N] [--list] [NAME ...]`` (see READ
 Each mutant of :data:`mutants.MUTANTS` replaces one exact snippet (it must occur exactly
 once in its file) in a fresh copy of the tracked and untracked files, then runs its test
 selection with ``pytest -x`` against that copy (its own kernel cache, so that nothing
-compiled from the real source is reused).  A mutant is *caught* when a test fails.
+compiled from the real source is reused).  A mutant is *caught* when a test fails; it is
+*NOT RUN* when pytest ran no test (exit 4: a path that does not exist; exit 5: a
+selection that matches nothing), which fails the run like a survivor.
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from mutants import MUTANTS  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
+#: pytest's exit codes that mean no test of the selection ran
+NOT_RUN = {4: "usage error: a test path or option that does not exist",
+           5: "no test collected: the selection matches nothing"}
 
 
 def _copy_tree(dest: Path) -> None:
@@ -34,6 +39,25 @@ def _copy_tree(dest: Path) -> None:
         if src.is_file():
             (dest / rel).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(src, dest / rel)
+
+
+def outcome_of(code, out: str) -> tuple[str, str]:
+    """What a pytest run of a mutant's selection says: (outcome, the catching test)."""
+    failed = re.findall(r"^FAILED (\S+)", out, re.M) or re.findall(r"^ERROR (\S+)", out, re.M)
+    last = out.strip().splitlines()[-1] if out.strip() else ""
+    if code == 0:
+        return "SURVIVED", ""
+    if code in NOT_RUN:
+        # no test ran: a test path that no longer exists (4) or a selection that matches
+        # nothing (5) says nothing about the mutant
+        return f"NOT RUN ({NOT_RUN[code]})", last
+    if code == "timeout":
+        return "timeout", ""
+    if failed:
+        return "caught", failed[0]
+    if code < 0 or "Fatal Python error" in out or "Segmentation fault" in out:
+        return "caught (crash)", f"signal {-code}" if code < 0 else "crash"
+    return f"caught (exit {code})", last
 
 
 def run_mutant(m, timeout: float) -> dict:
@@ -62,17 +86,7 @@ def run_mutant(m, timeout: float) -> dict:
         except subprocess.TimeoutExpired:
             out, code = "", "timeout"
         seconds = time.perf_counter() - start
-    failed = re.findall(r"^FAILED (\S+)", out, re.M) or re.findall(r"^ERROR (\S+)", out, re.M)
-    if code == 0:
-        outcome, test = "SURVIVED", ""
-    elif code == "timeout":
-        outcome, test = "timeout", ""
-    elif failed:
-        outcome, test = "caught", failed[0]
-    elif code < 0 or "Fatal Python error" in out or "Segmentation fault" in out:
-        outcome, test = "caught (crash)", f"signal {-code}" if code < 0 else "crash"
-    else:
-        outcome, test = f"caught (exit {code})", out.strip().splitlines()[-1] if out else ""
+    outcome, test = outcome_of(code, out)
     return {"name": m.name, "outcome": outcome, "test": test, "seconds": seconds}
 
 

@@ -31,7 +31,7 @@ from .._integrate import IntegrationWarning
 from .._loading import local_imports
 from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
-from ..kernels.cache import library_fingerprint
+from ..engine.cache import library_fingerprint
 from .report import summary
 from .spec import Study, StudyError, load_study
 from .theory import axis_units, for_study

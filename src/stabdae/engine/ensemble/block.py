@@ -1,13 +1,14 @@
 """The ensemble kernel: blocks of members in lockstep, structure of arrays, member innermost.
 
-Each work item (a block; ranges of blocks run on threads, :mod:`.threads`) holds a block
-of ``BLOCK`` members as arrays ``X[state, member]`` on the stack.  A step of the block is
-one loop over its members whose body is the member's whole explicit Runge–Kutta step
-(:func:`_member_step_source`): the stages written out, each a call of the stabilized
-right-hand side (:mod:`.rhs`, the user's functions inside), on buffers that live on the
-stack (:func:`stack1`, :func:`stack2`).  The step is generated for the scheme's pattern of
-zero / one / other coefficients (:func:`tableau_pattern`): zero terms are left out, factors
-one dropped, the values stay run-time arrays.
+Each work item (a block; ranges of blocks run on threads, :mod:`stabdae.engine.threads`)
+holds a block of ``BLOCK`` members as arrays ``X[state, member]`` on the stack. A step of
+the block is one loop over its members whose body is the member's whole explicit
+Runge–Kutta step (:func:`stabdae.engine.rk.steps._member_step_source`): the stages written
+out, each a call of the stabilized right-hand side (:mod:`stabdae.engine.rhs`, the user's
+functions inside), on buffers that live on the stack (:func:`stack1`, :func:`stack2`). The
+step is generated for the scheme's pattern of zero / one / other coefficients
+(:func:`stabdae.engine.rk.steps.tableau_pattern`): zero terms are left out, factors one
+dropped, the values stay run-time arrays.
 
 Every function of the step is compiled once and marked ``alwaysinline`` for LLVM
 (``forceinline=True``) rather than inlined at the numba IR level (``inline="always"``):
@@ -20,7 +21,7 @@ loop touches an alloca that no other pointer reaches (the parameters, the law's 
 and the tableau are copied to the stack first), LLVM keeps the buffers in registers and
 vectorizes the member loop without run-time alias checks.
 
-The library's own multiply-adds are fused (:mod:`.fma`) at the same places as in
+The library's own multiply-adds are fused (:mod:`stabdae.engine.fma`) at the same places as in
 :func:`stabdae.integrate`'s step.  Members never interact, so results are bit-for-bit the
 same for any thread count and any block size, and identical to :func:`stabdae.integrate`
 for the same initial state (the same operations in the same order: zero coefficients
@@ -54,9 +55,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .._status import Status
-from .cache import kernel_key, keyed_cache, memo, tag
-from .decay import (
+from ..._status import Status
+from ..cache import kernel_key, keyed_cache, memo, tag
+from ..decay import (
     MAP_MAX_NG,
     MAP_SHIFT,
     begin,
@@ -78,110 +79,15 @@ from .decay import (
     spectral_radius_of,
     windows_flush,
 )
-from .fma import fma
-from .rhs import kernels_for
-from .source import exec_source
-from .workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
+from ..rhs import kernels_for
+from ..rk.steps import _member_step, tableau_pattern
+from ..workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 
 BLOCK = 64
-#: the member step's sums over the state are written out per component while the state's
-#: size times the stages is at most this (a loop left in the step keeps the member loop
-#: around it from vectorizing; above it the code would grow with the model)
-UNROLL_MAX_TERMS = 200
 #: the ensemble kernel checks the block at least this often (steps) and keeps a copy of it
 CHECKPOINT = 32
 _NONFINITE = int(Status.NONFINITE_STATE)
 _DIVERGED = int(Status.DIVERGED)
-
-
-def _kind(value: float) -> int:
-    return 0 if value == 0.0 else 1 if value == 1.0 else 2
-
-
-def tableau_pattern(scheme) -> tuple:
-    """The kind of each coefficient of an explicit scheme: ``(a, b)`` with ``a[s]`` the
-    kinds of ``A[s, :s]`` and ``b`` those of the weights; 0 for zero, 1 for one, 2 for
-    any other value.  The ensemble kernel is compiled for one pattern and leaves the
-    zero terms out and the multiplications by one (exact) away; the values stay run-time
-    arrays."""
-    A, b = np.asarray(scheme.A), np.asarray(scheme.b)
-    a = tuple(tuple(_kind(A[s, q]) for q in range(s)) for s in range(b.shape[0]))
-    return a, tuple(_kind(w) for w in b)
-
-
-def _member_step_source(pattern, n2: int | None = None) -> str:
-    """Python source of one member's explicit Runge–Kutta step with the stages written
-    out, the zero terms of ``pattern`` left out and the factors equal to one dropped.
-    It returns the worst status of its right-hand sides and leaves the residual ``g`` at
-    the step's start in ``gv`` (read from the first stage's evaluation, for the decay
-    measurement); the new state's finiteness is left to the kernel's checks (a non-finite
-    state stays non-finite).
-
-    Written out rather than looped, so that the body has no inner loops left around the
-    inlined right-hand sides and the member loop around it vectorizes for any number of
-    stages (LLVM only vectorizes innermost loops and does not unroll a loop this large);
-    with the state's size ``n2`` given, the sums over the state are written out per
-    component too while ``n2`` times the stages is at most ``UNROLL_MAX_TERMS`` (Andrews'
-    14 components with DOP853's 12 stages: the loops were left, and the member loop ran
-    scalar), loops over ``N2`` otherwise.
-    The results are those of :mod:`.steps`' ``step`` bit for bit: it skips
-    the same zero terms, starts its sums from −0.0 (exact), and ``1.0 * x`` is ``x``.
-    """
-    a_kind, b_kind = pattern
-    stages = len(b_kind)
-
-    def written(statement):  # per component where that stays small (see the docstring)
-        if n2 is None or n2 * stages > UNROLL_MAX_TERMS:
-            return ["    for l in range(N2):", f"        {statement}"]
-        return [f"    {statement.replace('[l]', f'[{l}]')}" for l in range(n2)]
-
-    def stage_arg(s):  # x + Σ (τ a_sq) k_q, fused, in the order of ``step``; τ · 1 is τ
-        e = "xk[l]"
-        for q in range(s):
-            if a_kind[s][q]:
-                c = "tau" if a_kind[s][q] == 1 else f"(tau * tab_a[{s}, {q}])"
-                e = f"fma({c}, k{q}[l], {e})"
-        return e
-
-    def weights():  # Σ b_s k_s from −0.0 as ``step`` sums it: b k + (−0) is b k, 1 · k is k
-        e = None
-        for s in range(stages):
-            if not b_kind[s]:
-                continue
-            if e is None:
-                e = f"k{s}[l]" if b_kind[s] == 1 else f"tab_b[{s}] * k{s}[l]"
-            else:
-                e = f"({e} + k{s}[l])" if b_kind[s] == 1 else f"fma(tab_b[{s}], k{s}[l], {e})"
-        return e or "-0.0"
-
-    lines = ["def member_step(t, xk, tau, p, law_mat, law_scal, tab_a, tab_b, tab_c, ws, xs, xn,",
-             "                gv):"]
-    lines += [f"    k{s} = stack1(N2)" for s in range(stages)]
-    for s in range(stages):
-        arg = "xk"
-        if any(a_kind[s][:s]):
-            lines += written(f"xs[l] = {stage_arg(s)}")
-            arg = "xs"
-        lines.append(
-            f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg}, p, law_mat, law_scal, ws, k{s})"
-        )
-        if s == 0:  # g(x_k): the first stage has just evaluated it
-            lines += ["    for l in range(NG):", "        gv[l] = ws.g[l]"]
-    lines += written(f"xn[l] = fma(tau, {weights()}, xk[l])")
-    lines += [
-        "    return " + ("max(" + ", ".join(f"c{s}" for s in range(stages)) + ")"
-                        if stages > 1 else "c0"),
-    ]  # fmt: skip
-    return "\n".join(lines) + "\n"
-
-
-def _member_step(rhs, N2: int, NG: int, pattern):
-    label = "member_step_" + "".join(map(str, sum(pattern[0], ()) + pattern[1]))
-    ns = exec_source(_member_step_source(pattern, N2), label,
-                     {"rhs": rhs, "stack1": stack1, "N2": N2, "NG": NG, "fma": fma})  # fmt: skip
-    # inlined by numba into the kernel's member loop (its one call), not compiled on its
-    # own and then again inside the kernel: half a second of a new model's first ensemble
-    return njit(inline="always", error_model="numpy")(ns["member_step"])
 
 
 def pooled_constraints(model, law) -> int:
@@ -215,7 +121,7 @@ def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     n_params = len(model.param_names)
     pooled = pooled_constraints(model, bound.law)
     return memo(model, ("ensemble", bound.code, bound.fn, pattern, block, shape, pooled),
-                lambda: build_soa_kernel(kernels_for(model, bound), pattern, block, n_params,
+                lambda: build_block_kernel(kernels_for(model, bound), pattern, block, n_params,
                                          shape, pooled))  # fmt: skip
 
 
@@ -283,7 +189,7 @@ def block_failed(X, code):
     return bad
 
 
-def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1),
+def build_block_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1),
                      pooled: int = -1):  # fmt: skip
     """The block-lockstep ensemble kernel for the kernels ``K``, an explicit scheme whose
     coefficients are of the kinds ``pattern`` (:func:`tableau_pattern`), blocks of
@@ -329,7 +235,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
             dnrm[j] = d
 
     @njit(nogil=True, error_model="numpy")
-    def soa_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
+    def block_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
                    tab_b, tab_c, threshold, g_ref, R, stride, trace_row, out_norm, meas,
                    x_final, status, fail_step, e0, e1, g_out, b_lo, b_hi):  # fmt: skip
         """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
@@ -579,7 +485,7 @@ def build_soa_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shap
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
                             meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
 
-    key = kernel_key(K.key, "soa", pattern, block, n_params, law_shape, pooled)
+    key = kernel_key(K.key, "block", pattern, block, n_params, law_shape, pooled)
     tag(key, block_norms, member_step, pairs_full,
         *((bin_flush, end_flush) if FULL and pooled < 0 else ()))  # (closures only)
-    return keyed_cache(soa_kernel, key)
+    return keyed_cache(block_kernel, key)

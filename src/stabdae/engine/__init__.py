@@ -1,0 +1,26 @@
+"""The compiled floor: everything that runs inside Numba, and nothing else.
+
+Modules here take arrays, scalars and tuples, allocate nothing per step and return status
+codes instead of raising.  They import NumPy and Numba but never xarray, never a module of
+the floors above (not even for annotations), and never validate user input (the drivers
+one floor up do, once).  By role:
+
+* :mod:`.jit`, :mod:`.fma`, :mod:`.source` — whether the JIT runs, the fused multiply-add,
+  generated source registered for tracebacks;
+* :mod:`.linalg`, :mod:`.sparsity` — allocation-free L D Lᵀ (looped, and written out for
+  a model's sizes and patterns); the sparse right-hand side's index lists;
+* :mod:`.workspace` — the right-hand side's buffers, declared once by name, built on the
+  heap (one trajectory) or on the stack (a member slot of the ensemble kernel);
+* :mod:`.rhs` — the stabilized right-hand side (3.1), (3.11) for one model and law kind;
+* :mod:`.rk` — explicit Runge–Kutta steps: :mod:`.rk.steps` (the fixed step, looped and
+  generated, side by side), :mod:`.rk.control` (step-size control of the embedded pairs),
+  :mod:`.rk.adaptive` (the adaptive loop of one trajectory and its generated attempt);
+* :mod:`.ensemble` — the ensemble kernels: :mod:`.ensemble.block` (fixed steps, blocks of
+  members in lockstep) and :mod:`.ensemble.lanes` (adaptive steps, members on lanes);
+* :mod:`.decay` — the in-kernel measurement of the decay rate: :mod:`.decay.record`,
+  :mod:`.decay.ladder`, :mod:`.decay.fit`, :mod:`.decay.member`, :mod:`.decay.onestep`,
+  :mod:`.decay.traces`;
+* :mod:`.sampler` — placing initial states at prescribed constraint perturbations;
+* :mod:`.threads` — running ``nogil`` kernels over chunks of members on a thread pool;
+* :mod:`.cache` — per-model memo of the compiled closures and their on-disk cache.
+"""

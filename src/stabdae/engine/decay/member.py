@@ -1,0 +1,187 @@
+"""One member's measurement: begun at its initial residual, observed at every measured
+step, finished with its fit (envelope or one-step map) and its linear prediction."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .fit import STILL_DECAYING, estimate, grows, refit
+from .ladder import ladder_base, ladder_clear, ladder_level, records
+from .onestep import map_estimate, spectral_radius_of
+from .record import (
+    C_BETA,
+    C_BETA_PRED,
+    C_D2,
+    C_D3,
+    C_D4,
+    C_FINAL,
+    C_FIT_END,
+    C_FIT_START,
+    C_FLOOR,
+    C_FLOOR_REACHED,
+    C_GAMMA,
+    C_INITIAL,
+    C_KIND,
+    C_LARGEST,
+    C_POINTS,
+    C_REASON,
+    C_SHIFT,
+    C_W0,
+    C_W4,
+    K_MAP,
+    K_NONE,
+    NCOLS,
+    R_FITTED,
+    R_NOT_DECAYING,
+    R_STOPPED,
+)
+
+
+# --------------------------------------------------------------------- per member
+@njit(cache=True, forceinline=True)  # once per accepted step: a call with four arrays
+def observe(lt, lv, base, meas, j, row, t, v, d, window):  # costs as much as the step
+    """Step time ``t`` (from the start) of member ``row`` (ladder row ``j``), in fifth
+    ``window`` of the run: ``v`` its residual norm (the largest per fifth is kept), ``d``
+    the norm whose decay is measured (the ladder's; ``v`` itself, or the distance of the
+    residual from a reference trajectory's).  Non-finite norms are left out."""
+    if v < math.inf:
+        c = C_W0 + window
+        if not (meas[row, c] >= v):
+            meas[row, c] = v
+    if d < math.inf:
+        b = ladder_level(d, base[j])
+        lt[j, b] = t
+        lv[j, b] = d
+        if window >= 2:
+            c = C_D2 + window - 2
+            if not (meas[row, c] >= d):
+                meas[row, c] = d
+
+
+@njit(cache=True)
+def begin(lt, lv, base, meas, j, row, g0, d0):
+    """Start member ``row`` on ladder row ``j`` with its initial norms (as
+    :func:`observe`'s)."""
+    ladder_clear(lt, j)
+    base[j] = ladder_base(d0)
+    for c in range(NCOLS):
+        meas[row, c] = math.nan
+    for w in range(5):
+        meas[row, C_W0 + w] = -math.inf
+    for w in range(3):
+        meas[row, C_D2 + w] = -math.inf
+    meas[row, C_INITIAL] = g0
+    observe(lt, lv, base, meas, j, row, 0.0, g0, d0, 0)
+
+
+@njit(cache=True)
+def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
+    """Member ``row``'s measures from ladder row ``j`` at the end of its run (``final``:
+    the norm at its last state; ``stopped``: it did not run to the end)."""
+    still = summarize(meas, row, final, stopped)
+    if not stopped:
+        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+
+
+@njit(cache=True)
+def finish_with_map(lt, lv, S, meas, j, row, final, stopped, ng, pm, base_j, lowest, dt, rt,
+                    ry, a, b, lg):  # fmt: skip
+    """:func:`finish` for a member with one-step map sums ``S`` (:func:`map_estimate`,
+    ``dt`` the time between the map's pairs; ``lowest`` a level below which ladder row
+    ``j`` has no point): β from the map where it has one, else from
+    the envelope.  A member whose largest norms grow (:func:`grows`) gets the map only
+    when the envelope does not find it growing (it may decay first, which the map would
+    read), so its envelope is fitted first."""
+    still = summarize(meas, row, final, stopped)
+    if stopped:
+        return
+    out = meas[row]
+    if grows(out[C_D2], out[C_D3], out[C_D4]):
+        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+        if out[C_REASON] != R_NOT_DECAYING:
+            map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry, lowest)
+    elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry, lowest):
+        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+
+
+@njit(cache=True)
+def fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg):
+    """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
+    ``still``: the run ended while it was decaying)."""
+    n = records(lt, lv, j, rt, ry)
+    estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row])
+
+
+@njit(cache=True)
+def summarize(meas, row, final, stopped):
+    """Member ``row``'s columns other than the fit at the end of its run (``final``: the
+    norm at its last state; ``stopped``: it did not run to the end; then the fit's
+    columns say so).  Returns whether the measured norm was still decaying at the end."""
+    out = meas[row]
+    out[C_FINAL] = final
+    largest = -math.inf
+    for w in range(5):
+        if out[C_W0 + w] == -math.inf:
+            out[C_W0 + w] = math.nan
+        else:
+            largest = max(largest, out[C_W0 + w])
+    out[C_LARGEST] = largest if largest > -math.inf else math.nan
+    out[C_FLOOR] = out[C_W4]
+    # whether the measured norm is still falling at the end
+    still = (out[C_D2] >= STILL_DECAYING * out[C_D3]
+             and out[C_D3] >= STILL_DECAYING * out[C_D4])  # fmt: skip
+    out[C_FLOOR_REACHED] = 0.0 if still else 1.0
+    if stopped:
+        for c in (C_BETA, C_GAMMA, C_FIT_START, C_FIT_END, C_SHIFT):
+            out[c] = math.nan
+        out[C_POINTS] = 0
+        out[C_KIND] = K_NONE
+        out[C_REASON] = R_STOPPED
+    return still
+
+
+@njit(cache=True)
+def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g, gn,
+            rho_R=math.nan):  # fmt: skip
+    """Member ``row``'s predicted rate: ``g_{k+1} = R g_k`` from ``g_0 = alpha`` over the
+    steps up to its fit window's end, through ladder row ``j``, fitted over the measured
+    window with the measured kind; ``−ln ρ(R)/h`` for a member measured by its one-step
+    map (``rho_R``: ``ρ(R)`` when known).  ``g``, ``gn`` are scratch of the residual's
+    size."""
+    out = meas[row]
+    out[C_BETA_PRED] = math.nan
+    if out[C_REASON] != R_FITTED:
+        return
+    if out[C_KIND] == K_MAP:  # the map fitted to g_{k+1} = R g_k is R itself
+        rho = rho_R if rho_R == rho_R else spectral_radius_of(R)
+        out[C_BETA_PRED] = -math.log(rho) / h
+        return
+    ng = alpha.shape[0]
+    ladder_clear(lt, j)
+    nrm = 0.0
+    for i in range(ng):
+        g[i] = alpha[i]
+        nrm = max(nrm, abs(g[i]))
+    base[j] = ladder_base(nrm)
+    t_hi = out[C_FIT_END]
+    last = min(nsteps, int(math.ceil(t_hi / h - 1e-9)) + 1)
+    for k in range(last + 1):
+        if k > 0:
+            nrm = 0.0
+            for r in range(ng):
+                s = 0.0
+                for c in range(ng):
+                    s += R[r, c] * g[c]
+                gn[r] = s
+            for r in range(ng):
+                g[r] = gn[r]
+                nrm = max(nrm, abs(gn[r]))
+        if nrm < math.inf:
+            lev = ladder_level(nrm, base[j])
+            lt[j, lev] = k * h
+            lv[j, lev] = nrm
+    n = records(lt, lv, j, rt, ry)
+    out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, out[C_KIND], h, a, b, lg,
+                             out[C_SHIFT])  # fmt: skip

@@ -1,0 +1,587 @@
+"""The one-step map ``g_k -> g_{k+1}`` fitted by least squares from binned pairs of
+residuals (pooled per constraint block, or full for small residuals); the decay rate
+from its spectral radius and the prefactor from the ladder."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..workspace import stack1
+from .fit import FLOOR_MARGIN, MIN_DECADES
+from .ladder import _TINY, LEVELS_PER_OCTAVE, NBINS, ladder_level, log_normal, trailing_zeros
+from .record import (
+    C_BETA,
+    C_D2,
+    C_D3,
+    C_D4,
+    C_FIT_END,
+    C_FIT_START,
+    C_GAMMA,
+    C_KIND,
+    C_POINTS,
+    C_REASON,
+    C_SHIFT,
+    C_W0,
+    K_MAP,
+    R_FITTED,
+)
+
+#: the one-step map is fitted for residuals of at most this many components (its sums
+#: take 2 ng² numbers per bin and member)
+MAP_MAX_NG = 12
+#: its pairs are binned by the ladder level of ``‖g_k‖`` in bins of ``2^MAP_SHIFT``
+#: levels (two octaves)
+MAP_SHIFT = 4
+MAP_BINS = NBINS >> MAP_SHIFT
+#: eigenvalues of a fitted map whose rates differ by less than this fraction count as
+#: one repeated eigenvalue (:func:`_cluster_radius`); the rate read is then off by at most
+#: half of it
+CLUSTER = 0.02
+#: directions of the whitened pairs with less than this fraction of the largest's sum
+#: of squares are left out of the fit (no transient moves there: what is seen there is
+#: the floor's motion)
+MAP_RANK_TOL = 1e-12
+#: the pairs used lie above this many times the floor (then ``FLOOR_MARGIN``)
+MAP_MARGIN = 100.0
+#: all pairs are used when the largest norm fell from each of the last three fifths to
+#: the next, by this factor from the third to the fifth: the run ended inside the
+#: transient, where the largest norm of the last fifth is no floor (the map needs no
+#: window that ends above a floor, so a slower fall than the envelope's
+#: ``STILL_DECAYING`` suffices)
+MAP_STILL_DECAYING = 2.0
+
+
+# --------------------------------------------------------------------- one-step map
+@njit(cache=True)
+def map_buffers(rows, ng, pm):
+    """The one-step map's sums for ``rows`` members at a time: per member and bin ``b``
+    the sums of the pairs' outer products and their number (:func:`map_width` columns)
+    over the pairs ``(g_k, g_{k+1})`` with ``g_k`` before the member's measured norm
+    first fell below bin ``b`` (below ladder level ``b · 2^MAP_SHIFT``): the pairs of the
+    transient above that level, none of the floor's once the floor lies below it.
+
+    (Binned by when rather than by each pair's level, so that a member adds to its bins
+    once per bin crossed: a residual on its floor moves between levels at random, and
+    a member that moved its sums at every change of bin did so at every few measured
+    states, about a fifth of the measurement's cost on the pendulum.)"""
+    return np.zeros((rows, MAP_BINS, map_width(ng, pm)))
+
+
+@njit(cache=True)
+def map_width(ng, pm):
+    """The one-step map's sums per bin.
+
+    With ``pm ≥ 0`` the law acts alike on each of the ``pm`` holonomic constraints (one
+    2 × 2 block on every ``(f_i, ḟ_i)``) and on each nonholonomic one (one number on
+    every ``h_j``): the pairs of all constraints are pooled into one 2 × 2 and one 1 × 1
+    fit (11 sums).  Otherwise the full ``ng × ng`` map is fitted (``2 ng² + 1`` sums),
+    for residuals of at most ``MAP_MAX_NG`` components (none above)."""
+    if pm >= 0:
+        return 11
+    return 2 * ng * ng + 1 if ng <= MAP_MAX_NG else 0
+
+
+@njit(cache=True)
+def map_begin(S, j):
+    """Clear slot ``j``'s sums for a new member."""
+    for b in range(S.shape[1]):
+        for c in range(S.shape[2]):
+            S[j, b, c] = 0.0
+
+
+def full_rows(ng: int) -> int:
+    """The rows of the full one-step map's running sums (:func:`pairs_full`) for a residual
+    of ``ng`` components: Σ p pᵀ's upper triangle, Σ p' pᵀ, the count; 1 when
+    ``ng > MAP_MAX_NG`` (no full map)."""
+    return ng * (ng + 1) // 2 + ng * ng + 1 if ng <= MAP_MAX_NG else 1
+
+
+# The decay measurement of a block of members in lockstep (the ensemble kernel's): what
+# :func:`observe` and the one-step map's sums do member by member, here for the whole block
+# at once, in loops over its members (structure of arrays, member index innermost: they
+# vectorize), with the scattered writes deferred:
+#
+# * the ladder: each member's level (``block_levels``, vectorized), then the time and norm
+#   written on it (by the kernel, a scatter);
+# * the one-step map: the pairs' running sums in ``A`` (a row per sum, the symmetric
+#   ``Σ p pᵀ`` once), copied to the member's row of ``S`` for each bin its level goes below
+#   for the first time (``bin_flush``: a scalar loop over the members whose bit is set in
+#   the mask ``block_levels`` returns; a member crosses each bin once, where a flush at
+#   every change of bin came at every few measured states of a residual on its floor), and
+#   at the end for the bins it never went below (``end_flush``);
+# * the largest norms of the current fifth of the run in ``wmax`` and ``dmax``, written to
+#   the member's row when the fifth ends or the member stops (``windows_flush``).
+#
+# The ladder is :func:`observe`'s; bin ``b`` of the map's sums holds the pairs whose first
+# state came before the member's level first went below bin ``b`` (:func:`map_buffers`).
+# The block's size, the residual's and the constraints' come from the arrays' shapes and
+# the arguments, not from a closure: a closure per model was compiled on its own at each
+# new model's first ensemble (about a second in all).  Compiled once for every model
+# (cached) and inlined into the kernel, whose buffers have constant shapes.  (The
+# ladder's scatter is written in the kernel itself, and the full map's pairs and flushes
+# are closures, :func:`pairs_full_for` and :func:`flushes_for`: optimized on their own
+# over unknown sizes first, the scatter lost its vectorization and the copies their
+# unrolling, and the kernels were measurably slower: studies/README.md.)
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def difference_norms(Dv, gr, gn, dn):
+    """The block's residuals ``Dv`` (``g``, one column per slot) made ``g − gr``; their
+    norms ``‖g‖∞`` into ``gn`` and ``‖g − gr‖∞`` into ``dn``."""
+    ng, B = Dv.shape
+    for j in range(B):
+        gn[j] = 0.0
+        dn[j] = 0.0
+    for l in range(ng):
+        r = gr[l]
+        for j in range(B):
+            g = Dv[l, j]
+            d = g - r
+            Dv[l, j] = d
+            gn[j] = max(gn[j], abs(g))
+            dn[j] = max(dn[j], abs(d))
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def pairs_pooled(Dv, P, A, w, pm):
+    """The pairs (``P``: the previous measured residuals, ``Dv``: the current; their first
+    ``2 pm`` rows ``(f, ḟ)``, ``pm`` the holonomic constraints) added with weight ``w`` (0:
+    no previous one yet) to the pooled sums (10 rows: Σ p pᵀ's 3, Σ p' pᵀ's 4 over
+    ``p = (f_i, ḟ_i)``, Σ h², Σ h' h, the count); then ``P = Dv``."""
+    ng, B = Dv.shape
+    for i in range(pm):
+        for j in range(B):
+            a0 = P[i, j]
+            a1 = P[pm + i, j]
+            c0 = Dv[i, j]
+            c1 = Dv[pm + i, j]
+            A[0, j] += w * (a0 * a0)
+            A[1, j] += w * (a0 * a1)
+            A[2, j] += w * (a1 * a1)
+            A[3, j] += w * (c0 * a0)
+            A[4, j] += w * (c0 * a1)
+            A[5, j] += w * (c1 * a0)
+            A[6, j] += w * (c1 * a1)
+    for i in range(2 * pm, ng):
+        for j in range(B):
+            A[7, j] += w * (P[i, j] * P[i, j])
+            A[8, j] += w * (Dv[i, j] * P[i, j])
+    for j in range(B):
+        A[9, j] += w
+    for l in range(ng):
+        for j in range(B):
+            P[l, j] = Dv[l, j]
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def block_levels(gn, dn, base, low, nlev, wmax, dmax):
+    """The block's norms ``gn`` (of ``g``) and ``dn`` (measured) at a state: the largest of
+    the fifth, each slot's ladder level into ``nlev`` (``NBINS``, the ladder's spare
+    column, for a non-finite norm, which :func:`observe` leaves out); returns a mask of
+    the slots whose level went below ``low``, the lowest of the map's bins they had
+    reached (at most 64 slots)."""
+    changed = 0
+    for j in range(gn.shape[0]):
+        v = gn[j]
+        wm = wmax[j]
+        wmax[j] = v if (v < math.inf and not (wm >= v)) else wm
+        d = dn[j]
+        ok = d < math.inf
+        dm = dmax[j]
+        dmax[j] = d if (ok and not (dm >= d)) else dm
+        b = ladder_level(d, base[j])
+        nlev[j] = b if ok else NBINS
+        lower = ok and (b >> MAP_SHIFT) < low[j]
+        changed |= (1 if lower else 0) << j
+    return changed
+
+
+@njit(cache=True, forceinline=True)
+def _store(S, A, j, bin_, pooled, full):
+    """Slot ``j``'s sums so far as those of its bin ``bin_`` (``pooled ≥ 0``: the pooled
+    map's; else the full map's of ``full`` components, none when 0)."""
+    if pooled >= 0:
+        S[j, bin_, 0] = A[0, j]
+        S[j, bin_, 1] = A[1, j]
+        S[j, bin_, 2] = A[1, j]
+        S[j, bin_, 3] = A[2, j]
+        for c in range(4):
+            S[j, bin_, 4 + c] = A[3 + c, j]
+        S[j, bin_, 8] = A[7, j]
+        S[j, bin_, 9] = A[8, j]
+        S[j, bin_, 10] = A[9, j]
+    elif full:
+        c = 0
+        for r in range(full):
+            for q in range(r, full):
+                S[j, bin_, r * full + q] = A[c, j]
+                if q != r:
+                    S[j, bin_, q * full + r] = A[c, j]
+                c += 1
+        for r in range(full * full):
+            S[j, bin_, full * full + r] = A[c, j]
+            c += 1
+        S[j, bin_, 2 * full * full] = A[c, j]
+
+
+@njit(cache=True, error_model="numpy")
+def bin_flush(S, A, nlev, low, mask, pooled, full):
+    """The slots of the set bits of ``mask``, whose level went below the lowest bin they
+    had reached: their sums so far (the pair just added, from a state above, included)
+    become those of each bin passed, down to the new one's, which is then the lowest
+    (``pooled``, ``full``: :func:`_store`)."""
+    while mask != 0:
+        j = trailing_zeros(mask)
+        mask &= mask - 1
+        nb = nlev[j] >> MAP_SHIFT
+        for b in range(nb + 1, low[j] + 1):
+            _store(S, A, j, b, pooled, full)
+        low[j] = nb
+
+
+@njit(cache=True, error_model="numpy")
+def end_flush(S, A, low, active, pooled, full):
+    """At the end of the run: each running slot's sums as those of the bins it did not go
+    below."""
+    for j in range(low.shape[0]):
+        if active[j]:
+            for b in range(low[j] + 1):
+                _store(S, A, j, b, pooled, full)
+
+
+@njit(cache=True, error_model="numpy")
+def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
+    """The largest norms of fifth ``window`` so far to the rows of the running members;
+    then cleared."""
+    for j in range(cnt):
+        if active[j]:
+            row = lo + j
+            c = C_W0 + window
+            if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
+                meas[row, c] = wmax[j]
+            if window >= 2:
+                c = C_D2 + window - 2
+                if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
+                    meas[row, c] = dmax[j]
+    for j in range(wmax.shape[0]):
+        wmax[j] = -math.inf
+        dmax[j] = -math.inf
+
+
+def pairs_full_for(B: int, ng: int):
+    """As :func:`pairs_pooled` for the full map of ``ng`` components over blocks of ``B``
+    slots, ``pairs(Dv, P, A, w)`` (``A``: :func:`full_rows` rows): Σ p pᵀ (upper
+    triangle), Σ p' pᵀ, the count.  A closure over the sizes, compiled per kernel that
+    uses it: sized by its arrays and optimized on its own, its 2 ng² short loops each
+    checked their arrays for overlap at run time (slower; studies/README.md has the
+    figures)."""
+
+    @njit(forceinline=True, error_model="numpy")
+    def pairs_full(Dv, P, A, w):
+        c = 0
+        for r in range(ng):
+            for q in range(r, ng):
+                for j in range(B):
+                    A[c, j] += w * (P[r, j] * P[q, j])
+                c += 1
+        for r in range(ng):
+            for q in range(ng):
+                for j in range(B):
+                    A[c, j] += w * (Dv[r, j] * P[q, j])
+                c += 1
+        for j in range(B):
+            A[c, j] += w
+        for l in range(ng):
+            for j in range(B):
+                P[l, j] = Dv[l, j]
+
+    return pairs_full
+
+
+def flushes_for(FULL: int):
+    """``(bin_flush, end_flush)`` for a kernel whose one-step map is the full one of
+    ``FULL`` components: closures over it (the full map's copy of a slot's sums, sized
+    at run time in :func:`bin_flush`, was slower than this unrolled one with a full law
+    matrix).  For ``FULL = 0`` (the pooled
+    map, or none) :func:`bin_flush` and :func:`end_flush` themselves, compiled once for
+    every model.  Both take ``(…, pooled, full)`` as those do."""
+    if not FULL:
+        return bin_flush, end_flush
+
+    @njit(forceinline=True)
+    def _store_full(S, A, j, bin_):
+        c = 0
+        for r in range(FULL):
+            for q in range(r, FULL):
+                S[j, bin_, r * FULL + q] = A[c, j]
+                if q != r:
+                    S[j, bin_, q * FULL + r] = A[c, j]
+                c += 1
+        for r in range(FULL * FULL):
+            S[j, bin_, FULL * FULL + r] = A[c, j]
+            c += 1
+        S[j, bin_, 2 * FULL * FULL] = A[c, j]
+
+    @njit(error_model="numpy")
+    def bin_flush_full(S, A, nlev, low, mask, pooled, full):
+        while mask != 0:
+            j = trailing_zeros(mask)
+            mask &= mask - 1
+            nb = nlev[j] >> MAP_SHIFT
+            for b in range(nb + 1, low[j] + 1):
+                _store_full(S, A, j, b)
+            low[j] = nb
+
+    @njit(error_model="numpy")
+    def end_flush_full(S, A, low, active, pooled, full):
+        for j in range(low.shape[0]):
+            if active[j]:
+                for b in range(low[j] + 1):
+                    _store_full(S, A, j, b)
+
+    return bin_flush_full, end_flush_full
+
+
+@njit(cache=True)
+def _cluster_radius(moduli, n):
+    """The largest modulus, or the geometric mean of those within ``CLUSTER`` of it in
+    rate (``ln`` of the modulus): a repeated eigenvalue (a Jordan block, as critically
+    damped laws give) splits by the square root of a perturbation of the matrix, its
+    mean by the perturbation itself."""
+    top = 0.0
+    for i in range(n):
+        top = max(top, moduli[i])
+    if not (top > 0.0) or top == math.inf:
+        return top
+    width = CLUSTER * abs(math.log(top))
+    logs = 0.0
+    count = 0
+    for i in range(n):
+        if moduli[i] > 0.0 and math.log(top / moduli[i]) <= width:
+            logs += math.log(moduli[i])
+            count += 1
+    return math.exp(logs / count)
+
+
+@njit(cache=True)
+def _radius2(r00, r01, r10, r11):
+    """:func:`spectral_radius_of` of the 2 × 2 matrix ``[[r00, r01], [r10, r11]]`` in
+    closed form, without arrays (NaN for non-finite entries)."""
+    half = 0.5 * (r00 + r11)
+    det = r00 * r11 - r01 * r10
+    disc = half * half - det
+    if disc < 0.0:
+        return math.sqrt(det)
+    big = abs(half + math.sqrt(disc))
+    small = abs(half - math.sqrt(disc))
+    if big < small:
+        big, small = small, big
+    if not (big > 0.0) or big == math.inf or not (small > 0.0):
+        return big
+    if math.log(big / small) <= CLUSTER * abs(math.log(big)):  # as _cluster_radius
+        return math.sqrt(big * small)
+    return big
+
+
+@njit(cache=True)
+def spectral_radius_of(R):
+    """``ρ(R)`` of a small real matrix (closed form up to 2 × 2), where eigenvalues of
+    nearly the same modulus count as one repeated eigenvalue (:func:`_cluster_radius`):
+    the rate an ensemble measures from a fitted map, and the one a finite run shows."""
+    n = R.shape[0]
+    if n == 1:
+        return abs(R[0, 0])
+    if n == 2:
+        return _radius2(R[0, 0], R[0, 1], R[1, 0], R[1, 1])
+    for i in range(n):
+        for q in range(n):
+            if not math.isfinite(R[i, q]):
+                return math.nan
+    # complex input: numba's real eigvals refuses complex eigenvalues
+    lam = np.linalg.eigvals(R.astype(np.complex128))
+    moduli = np.empty(n)
+    for i in range(n):
+        moduli[i] = abs(lam[i])
+    return _cluster_radius(moduli, n)
+
+
+@njit(cache=True)
+def _pooled_radius(S, j, first):
+    """``ρ`` of the pooled fits (:func:`map_buffers`): the larger of the 2 × 2 map of
+    the ``(f_i, ḟ_i)`` pairs and the 1 × 1 map of the ``h_j``, each where it has data,
+    from the pairs of bin ``first`` (those before the level first fell below it); the
+    number of pairs."""
+    s = stack1(11)
+    for c in range(11):
+        s[c] = S[j, first, c] if first < S.shape[1] else 0.0
+    rho = -1.0
+    det = s[0] * s[3] - s[1] * s[2]
+    if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:  # S1 S0⁻¹
+        rho = _radius2((s[4] * s[3] - s[5] * s[2]) / det, (s[5] * s[0] - s[4] * s[1]) / det,
+                       (s[6] * s[3] - s[7] * s[2]) / det, (s[7] * s[0] - s[6] * s[1]) / det)
+    if s[8] > 0.0:
+        rho = max(rho, abs(s[9] / s[8]))
+    return (rho if rho >= 0.0 else math.nan), s[10]
+
+
+@njit(cache=True)
+def _map_radius(S, j, ng, first):
+    """``ρ`` of the least-squares one-step map ``R̂ = S1 S0⁻¹`` from bin ``first`` of
+    slot ``j`` (the pairs before its level first fell below that bin), on the directions
+    its pairs span, and the number of pairs; NaN with fewer than ``2 ng`` pairs."""
+    S0 = np.zeros((ng, ng))
+    S1 = np.zeros((ng, ng))
+    pairs = 0.0
+    if first < S.shape[1]:
+        c = 0
+        for r in range(ng):
+            for q in range(ng):
+                S0[r, q] = S[j, first, c]
+                c += 1
+        for r in range(ng):
+            for q in range(ng):
+                S1[r, q] = S[j, first, c]
+                c += 1
+        pairs = S[j, first, c]
+    if pairs < 2.0 * ng:
+        return math.nan, pairs
+    # Whitened (each component scaled to unit sum of squares) and restricted to the
+    # directions the pairs span: Baumgarte's law acts alike on every constraint, so the
+    # residual of m constraints moves in a plane of its 2m dimensions, and a fit over all
+    # of them gives the remaining directions the floor's dynamics.
+    w = np.zeros(ng)
+    for r in range(ng):
+        if S0[r, r] > 0.0:
+            w[r] = 1.0 / math.sqrt(S0[r, r])
+    for r in range(ng):
+        for q in range(ng):
+            S0[r, q] *= w[r] * w[q]
+            S1[r, q] *= w[r] * w[q]
+    lam, U = np.linalg.eigh(S0)
+    top = lam[ng - 1]
+    if not (top > 0.0):
+        return math.nan, pairs
+    keep = 0
+    for i in range(ng):
+        if lam[i] >= MAP_RANK_TOL * top:
+            keep += 1
+    V = np.ascontiguousarray(U[:, ng - keep:])
+    # R̂ on that subspace: (Vᵀ S1 V)(Vᵀ S0 V)⁻¹, Vᵀ S0 V the kept eigenvalues
+    Rr = np.ascontiguousarray(V.T) @ S1 @ V
+    for q in range(keep):
+        for r in range(keep):
+            Rr[r, q] /= lam[ng - keep + q]
+    return spectral_radius_of(Rr), pairs
+
+
+@njit(cache=True, error_model="numpy")
+def _map_gamma(lt, lv, j, lo, top, beta, u):
+    """``γ = max ‖g(t)‖ e^{βt}`` over the envelope's points on levels ``lo … top`` of
+    ladder row ``j``, and the latest time on them (``u``: scratch of ``NBINS``).
+
+    Taken over every visited level, not only the envelope's: a level's last visit that
+    is not on the envelope has a higher level visited later, whose larger norm at a later
+    time gives a larger product (β > 0), so the maximum is the same.  Without the
+    envelope's running comparison, and with ``ln ‖g‖ + βt`` computed in a loop of its own
+    (branch-free: it vectorizes) and the exponential taken once, of the largest (it is
+    monotone), this costs a fraction of the envelope's loop with an exponential per
+    point, which was most of the cost of a member's end.  (A zero or subnormal norm,
+    where :func:`log_normal` does not hold, is left out: a zero's product is zero, and a
+    subnormal one, below 1e-308, lies on the ladder's bottom level, far under any
+    transient.)
+
+    The levels are indexed unsigned: numba wraps a negative index around, and an index
+    that may be negative (``lo`` is not known to be ≥ 0) turns every load of the
+    vectorized loop into a gather and its store into a scatter (several times the time
+    of the whole pass).  The maxima are kept in eight running ones (a single one
+    is a chain of dependent comparisons); the maximum of a set is the same in any
+    order."""
+    lo = max(lo, 0)
+    ltj = lt[j]
+    lvj = lv[j]
+    for i in range(top + 1 - lo):
+        b = np.uint64(lo + i)
+        t = ltj[b]
+        v = lvj[b]
+        ok = (t >= 0.0) & (v >= _TINY) & (v < math.inf)
+        u[b] = (log_normal(v if ok else 1.0) + beta * t) if ok else -math.inf
+    acc = stack1(16)  # eight running maxima of the products, eight of the times
+    for i in range(8):
+        acc[i] = -math.inf
+        acc[8 + i] = -1.0
+    b0 = lo
+    while b0 + 8 <= top + 1:
+        for i in range(8):
+            b = np.uint64(b0 + i)
+            acc[i] = max(acc[i], u[b])
+            acc[8 + i] = max(acc[8 + i], ltj[b])
+        b0 += 8
+    best = -math.inf
+    t_end = -1.0
+    for i in range(8):
+        best = max(best, acc[i])
+        t_end = max(t_end, acc[8 + i])
+    for b in range(b0, top + 1):
+        best = max(best, u[b])
+        t_end = max(t_end, ltj[b])
+    return (math.exp(best) if best > -math.inf else 0.0), t_end
+
+
+@njit(cache=True)
+def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry, lowest=0):
+    """β of member ``row`` from its one-step map, replacing the envelope's fit.
+
+    The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
+    still decaying (``MAP_STILL_DECAYING``), else those from its start until its level
+    first fell below ``MAP_MARGIN`` (then ``FLOOR_MARGIN``) times its floor (rounded up
+    to a bin of :func:`map_buffers`), give ``R̂`` by least squares; ``β = −ln ρ(R̂)/τ``.
+    For a residual that follows ``g_{k+1} = R g_k`` this is ``−ln ρ(R)/τ`` exactly,
+    whatever the window, the modes' mix or a repeated eigenvalue's polynomial prefactor,
+    where a fit of the norm's envelope over a short transient is biased.  The pairs must
+    span a decade (``MIN_DECADES``) above the cut; a member without such pairs, or whose
+    map is singular or has ``ρ ≥ 1``, is left to the envelope's fit
+    (:func:`fit_envelope`).
+    ``lowest``: no level below it was visited (γ's pass starts there).  Returns whether
+    it gave β."""
+    out = meas[row]
+    if S.shape[2] == 0:
+        return False
+    floor = out[C_D4]
+    still = (out[C_D2] > out[C_D3] > out[C_D4]
+             and out[C_D2] >= MAP_STILL_DECAYING * out[C_D4])  # fmt: skip
+    top = -1
+    for b in range(NBINS - 1, -1, -1):
+        if lt[j, b] >= 0.0:
+            top = b
+            break
+    per_decade = LEVELS_PER_OCTAVE * math.log2(10.0) * MIN_DECADES
+    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN):
+        if margin < 0.0:  # still decaying: the last fifth's largest norm is no floor
+            if not still:
+                continue
+            cut = 0
+        elif floor > 0.0:
+            cut = ladder_level(margin * floor, base_j) + 1
+        else:
+            cut = 0
+        if top - cut < per_decade:
+            continue
+        first = (cut + (1 << MAP_SHIFT) - 1) >> MAP_SHIFT  # bins wholly above the cut
+        rho, pairs = _pooled_radius(S, j, first) if pm >= 0 else _map_radius(S, j, ng, first)
+        if not (rho < 1.0 and rho > 0.0):
+            return False
+        beta = -math.log(rho) / tau
+        gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta, ry)
+        out[C_BETA] = beta
+        out[C_GAMMA] = gamma
+        out[C_FIT_START] = 0.0
+        out[C_FIT_END] = t_end
+        out[C_POINTS] = pairs
+        out[C_KIND] = K_MAP
+        out[C_SHIFT] = math.nan
+        out[C_REASON] = R_FITTED
+        return True
+    return False

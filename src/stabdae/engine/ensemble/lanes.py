@@ -1,0 +1,285 @@
+"""The adaptive ensemble kernel (:func:`adaptive_block_for`, behind
+``stabdae.ensemble(rtol=...)``): members run on ``LANES`` lanes side by side, each with its
+own step size, with the same operations per member as the loop of one trajectory
+(:mod:`stabdae.engine.rk.adaptive`, whose generated attempted step it runs), so that each
+member is that loop's trajectory bit for bit.  A lane whose member ends takes the next
+member of its block.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..cache import kernel_key, keyed_cache, memo, tag
+from ..decay import begin, finish, ladders, observe, predict, scratch
+from ..rhs import kernels_for
+from ..rk.adaptive import _label, _pattern, attempt_for
+from ..rk.control import _DIVERGED, _f_eval, _first_step, _next_step, _settle
+
+# ------------------------------------------------------------------- lanes in lockstep
+#: members integrated side by side (lanes) in the block adaptive ensemble kernel
+LANES = 8
+
+
+def adaptive_block_for(model, bound, pair, lanes: int = LANES):
+    """The compiled block adaptive ensemble kernel (memoized per law kind, the pair's
+    stage counts and norm, the number of lanes, the shape of the law's matrix)."""
+    s, s_e = pair.scheme.stages, pair.error.shape[1]
+    shape = bound.matrix.shape
+    n_params = len(model.param_names)
+    pattern = _pattern(pair)
+    return memo(model, ("adaptive-block", bound.code, bound.fn, s, s_e, pair.combined, pattern,
+                        lanes, shape),
+                lambda: _build_adaptive_block(kernels_for(model, bound), s, s_e,
+                                              pair.combined, pattern, lanes, n_params,
+                                              shape))  # fmt: skip
+
+
+def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B: int,
+                          n_params: int, law_shape):  # fmt: skip
+    from ..workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
+
+    rhs, residual, energy = K.rhs, K.residual, K.energy
+    make_workspace, stack_workspace = K.make_workspace, K.stack_workspace
+    N2, ng = 2 * K.n, K.ng
+    NP = max(n_params, 1)
+    LR, LC = law_shape
+    label = _label(s, s_e, combined, pattern)
+    attempt = attempt_for(rhs, s, s_e, combined, pattern, N2, ng)
+
+    f_eval = _f_eval(rhs)
+    first_step = _first_step(f_eval, N2)
+
+    @njit(nogil=True, error_model="numpy")
+    def block_kernel(x0, alpha0s, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_e,
+                     tab_c, q, rtol, atol, h0, max_steps, divergence, R, h_pred, trace_row,
+                     norms, meas, x_final, status, fail_step, e0, e1, steps, nfev, lo,
+                     hi):  # fmt: skip
+        """Members ``lo … hi − 1`` on ``B`` lanes: each lane runs one member with its own
+        step size, error norm and accept/reject; the attempted steps of all lanes are one
+        loop over the lanes (vectorized), the step-size control, samples and decay
+        measurement a scalar pass after it; a lane whose member has finished (or
+        stopped) takes the next waiting member.  Outputs as the per-member kernel's."""
+        if hi <= lo:
+            return
+        expo = 1.0 / (q + 1)
+        nsave = save_times.shape[0]
+        tend = save_times[nsave - 1]
+        span = tend - t0
+        # the small run-time inputs on the stack (copy_inputs: no aliasing)
+        p_s = stack1(NP)
+        lm = stack2(LR, LC)
+        ls = stack1(1)
+        copy_inputs(p, law_mat, law_scal, p_s, lm, ls)
+        ta = stack2(s, s)
+        tb = stack1(s)
+        tc = stack1(s)
+        te = stack2(2, s_e)
+        copy_tableau(tab_a, tab_b, tab_c, ta, tb, tc)
+        for i in range(2):
+            for j in range(s_e):
+                te[i, j] = tab_e[i, j]
+        # per lane: state, first stage, attempt's new state and last stage; time, step
+        X = stack2(N2, B)
+        K0 = stack2(N2, B)
+        XN = stack2(N2, B)
+        KL = stack2(N2, B)
+        T = stack1(B)
+        HH = stack1(B)
+        E = stack1(B)
+        RN = stack1(B)
+        GOOD = stack_int1(B)
+        NEV = stack_int1(B)
+        H = np.empty(B)
+        hit = np.zeros(B, dtype=np.bool_)
+        after = np.zeros(B, dtype=np.bool_)
+        jj = np.zeros(B, dtype=np.int64)  # the next sample
+        mem = np.full(B, -1, dtype=np.int64)  # the lane's member, −1: none
+        acc_n = np.zeros(B, dtype=np.int64)
+        rej_n = np.zeros(B, dtype=np.int64)
+        fev_n = np.zeros(B, dtype=np.int64)
+        ws_h = make_workspace()
+        x_h = np.empty(N2)
+        k0_h = np.empty(N2)
+        k1_h = np.empty(N2)
+        xs_h = np.empty(N2)
+        g_h = np.empty(ng)
+        lt, lv, base = ladders(B)
+        rt, ry, fa, fb, lg = scratch()
+        g_p = np.empty(alpha0s.shape[1])
+        gn_p = np.empty(alpha0s.shape[1])
+        nxt = lo
+        alive = 0
+        for lane in range(B):
+            for l in range(N2):
+                X[l, lane] = 0.0
+                K0[l, lane] = 0.0
+            T[lane] = t0
+            HH[lane] = 0.0
+        while True:
+            # ---- scalar pass: settle each lane's attempt, then fill empty lanes
+            for lane in range(B):
+                i = mem[lane]
+                st = 0
+                if i >= 0 and HH[lane] > 0.0:  # an attempt was made
+                    fev_n[lane] += NEV[lane]
+                    hh = HH[lane]
+                    ok, H[lane], after[lane] = _settle(GOOD[lane] != 0, E[lane], hh, H[lane],
+                                                       hit[lane], after[lane], expo)
+                    if ok:
+                        acc_n[lane] += 1
+                        t = save_times[jj[lane]] if hit[lane] else T[lane] + hh
+                        T[lane] = t
+                        for l in range(N2):
+                            X[l, lane] = XN[l, lane]
+                            K0[l, lane] = KL[l, lane]
+                        window = min(4, int(5.0 * (t - t0) / span))
+                        observe(lt, lv, base, meas, lane, i, t - t0, RN[lane], RN[lane],
+                                window)  # fmt: skip
+                        if hit[lane]:
+                            jj[lane] += 1
+                            for l in range(N2):
+                                x_h[l] = X[l, lane]
+                            residual(t, x_h, p, ws_h, g_h)
+                            r = 0.0
+                            for l in range(ng):
+                                r = max(r, abs(g_h[l]))
+                            if not math.isfinite(r):
+                                r = math.inf
+                            if trace_row[i] >= 0:
+                                norms[trace_row[i], jj[lane]] = r
+                            if not (r <= divergence):
+                                st = _DIVERGED
+                            elif jj[lane] == nsave:
+                                st = -1  # done
+                    else:
+                        rej_n[lane] += 1
+                if i >= 0 and st == 0:  # the next attempt: its step, or a stop
+                    HH[lane], hit[lane], st = _next_step(T[lane], H[lane],
+                                                         save_times[jj[lane]],
+                                                         acc_n[lane] + rej_n[lane],
+                                                         max_steps)  # fmt: skip
+                if i >= 0 and st != 0:  # the member's end: its outputs
+                    st = 0 if st == -1 else st
+                    for l in range(N2):
+                        x_h[l] = X[l, lane]
+                        x_final[i, l] = x_h[l]
+                    status[i] = st
+                    steps[i] = acc_n[lane]
+                    nfev[i] = fev_n[lane]
+                    final = math.nan
+                    if st != 0:
+                        fail_step[i] = acc_n[lane]
+                    else:
+                        e1[i] = energy(tend, x_h, p, ws_h)
+                        residual(tend, x_h, p, ws_h, g_h)
+                        final = 0.0
+                        for l in range(ng):
+                            final = max(final, abs(g_h[l]))
+                    finish(lt, lv, meas, lane, i, final, st != 0,
+                           span / max(acc_n[lane], 1), rt, ry, fa, fb, lg)  # fmt: skip
+                    if R.shape[0] > 0:
+                        predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt, lv,
+                                base, meas, lane, i, rt, ry, fa, fb, lg, g_p,
+                                gn_p)  # fmt: skip
+                    mem[lane] = -1
+                    alive -= 1
+                while mem[lane] < 0 and nxt < hi:  # the next waiting member
+                    i = nxt
+                    nxt += 1
+                    for l in range(N2):
+                        x_h[l] = x0[i, l]
+                    if trace_row[i] >= 0:
+                        for c in range(norms.shape[1]):
+                            norms[trace_row[i], c] = math.nan
+                    if status[i] != 0:  # not placed: keep it out
+                        for l in range(N2):
+                            x_final[i, l] = x_h[l]
+                        begin(lt, lv, base, meas, lane, i, math.nan, math.nan)
+                        finish(lt, lv, meas, lane, i, math.nan, True, 1.0, rt, ry, fa, fb, lg)
+                        continue
+                    e0[i] = energy(t0, x_h, p, ws_h)
+                    residual(t0, x_h, p, ws_h, g_h)
+                    r0 = 0.0
+                    for l in range(ng):
+                        r0 = max(r0, abs(g_h[l]))
+                    begin(lt, lv, base, meas, lane, i, r0, r0)
+                    acc_n[lane] = rej_n[lane] = fev_n[lane] = 0
+                    # sample 0 (as the single loop's save: ‖g‖ at t0, checked)
+                    r = r0 if math.isfinite(r0) else math.inf
+                    if trace_row[i] >= 0:
+                        norms[trace_row[i], 0] = r
+                    st = 0 if r <= divergence else _DIVERGED
+                    if st == 0:
+                        st = f_eval(t0, x_h, p, law_mat, law_scal, ws_h, k0_h)
+                        fev_n[lane] = 1
+                    h = h0
+                    if st == 0:
+                        h, nf = first_step(t0, x_h, k0_h, k1_h, xs_h, p, law_mat, law_scal,
+                                           ws_h, rtol, atol, h0, tend, expo)  # fmt: skip
+                        fev_n[lane] += nf
+                        hh, hit[lane], st = _next_step(t0, h, save_times[0], 0, max_steps)
+                    if st != 0:
+                        for l in range(N2):
+                            x_final[i, l] = x_h[l]
+                        status[i] = st
+                        steps[i] = 0
+                        nfev[i] = fev_n[lane]
+                        fail_step[i] = 0
+                        finish(lt, lv, meas, lane, i, math.nan, True, span, rt, ry, fa, fb,
+                               lg)  # fmt: skip
+                        if R.shape[0] > 0:
+                            predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt,
+                                    lv, base, meas, lane, i, rt, ry, fa, fb, lg, g_p,
+                                    gn_p)  # fmt: skip
+                        continue
+                    mem[lane] = i
+                    alive += 1
+                    jj[lane] = 0
+                    after[lane] = False
+                    H[lane] = h
+                    HH[lane] = hh
+                    T[lane] = t0
+                    for l in range(N2):
+                        X[l, lane] = x_h[l]
+                        K0[l, lane] = k0_h[l]
+            if alive == 0:
+                break
+            # an idle lane repeats a running one (numbers nobody reads, none failing)
+            src = 0
+            while mem[src] < 0:
+                src += 1
+            for lane in range(B):
+                if mem[lane] < 0:
+                    T[lane] = T[src]
+                    HH[lane] = HH[src]
+                    for l in range(N2):
+                        X[l, lane] = X[l, src]
+                        K0[l, lane] = K0[l, src]
+            # ---- vector pass: every lane's attempted step
+            for lane in range(B):
+                ws = stack_workspace()
+                x = stack1(N2)
+                k0 = stack1(N2)
+                xs = stack1(N2)
+                xn = stack1(N2)
+                kl = stack1(N2)
+                for l in range(N2):
+                    x[l] = X[l, lane]
+                    k0[l] = K0[l, lane]
+                good, nev, e, r = attempt(T[lane], HH[lane], x, k0, p_s, lm, ls, ta, tb, te,
+                                          tc, rtol, atol, ws, xs, xn, kl)  # fmt: skip
+                for l in range(N2):
+                    XN[l, lane] = xn[l]
+                    KL[l, lane] = kl[l]
+                GOOD[lane] = good
+                NEV[lane] = nev
+                E[lane] = e
+                RN[lane] = r
+
+    tag(kernel_key(K.key, f"adaptive-block-{label}-{B}"), attempt, f_eval, first_step)
+    keyed_cache(block_kernel, kernel_key(K.key, f"adaptive-block-{label}-{B}-{NP}-{LR}x{LC}"))
+    return block_kernel
