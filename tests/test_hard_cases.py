@@ -134,6 +134,19 @@ def test_adaptive_rejects_bad_tolerances():
         stabdae.integrate_adaptive(model, None, stabdae.none(), 1.0, atol=0.0)
 
 
+@pytest.mark.parametrize(("rtol", "atol", "message"), [
+    (1e-17, None, "rtol = 1e-17 is below 100 machine epsilons"),
+    (1e-8, 0.0, "atol must be positive"),
+    (-1e-8, None, "rtol must be positive"),
+])  # fmt: skip
+def test_adaptive_ensemble_takes_the_same_tolerance_rule(rtol, atol, message):
+    """ensemble(rtol=) refuses what integrate_adaptive refuses, with the caller's name."""
+    model = load_scene("pendulum")
+    with pytest.raises(ValueError, match=f"^ensemble: {message}"):
+        stabdae.ensemble(model, stabdae.baumgarte(10.0), None, 1e-3, 1.0, members=4,
+                         rtol=rtol, atol=atol)  # fmt: skip
+
+
 def test_redundant_four_bar_default_stops_naming_S():
     model = load_scene("four_bar_redundant")
     with pytest.warns(stabdae.IntegrationWarning, match=r"singular constraint matrix S"):

@@ -12,6 +12,7 @@ below it: :mod:`stabdae.engine` (compiled), the drivers and definitions here,
 from . import _vector_width, theory  # noqa: F401
 from ._adaptive import integrate_adaptive
 from ._boundary import boundary
+from ._codes import Status
 from ._ensemble import ensemble, sample_perturbations
 from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, acpr, baumgarte, matrix, none, theorem5, user
@@ -30,7 +31,6 @@ from ._schemes import (
     rk4,
     two_stage,
 )
-from ._status import Status
 from ._version import __version__
 
 __all__ = [

@@ -11,10 +11,10 @@ import warnings
 import numpy as np
 
 from . import _validate as check
+from ._codes import Status
 from ._integrate import IntegrationWarning, _multipliers
 from ._model import Model
 from ._schema import trajectory_dataset
-from ._status import Status
 from .engine.rk.adaptive import adaptive_for
 
 __all__ = ["integrate_adaptive"]
@@ -92,13 +92,7 @@ def integrate_adaptive(
     who = "integrate_adaptive"
     model = check.model(model, who)
     law = check.law(law, who, "stabdae.none() or stabdae.baumgarte(omega=10.0, xi=1.0)")
-    rtol = check.positive(rtol, "rtol", who)
-    atol = check.positive(atol, "atol", who)
-    if rtol < 100 * np.finfo(float).eps:
-        raise ValueError(
-            f"{who}: rtol = {rtol:g} is below 100 machine epsilons "
-            f"({100 * np.finfo(float).eps:.1e}); the error estimate is roundoff"
-        )
+    rtol, atol = check.tolerances(rtol, atol, who)
     p = check.params(model, params, who)
     t0 = model.t0 if t0 is None else check.real(t0, "t0", who)
     check.span(t0, t_end, who)

@@ -22,11 +22,11 @@ import xarray as xr
 
 from . import _measures, theory
 from . import _validate as check
+from ._codes import Status
 from ._integrate import IntegrationWarning
 from ._laws import Theorem5
 from ._model import Model
 from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_variable, variable
-from ._status import Status
 from .engine import decay
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
 from .engine.ensemble.lanes import LANES, adaptive_block_for
@@ -48,17 +48,6 @@ REFERENCE_MAX_ENTRIES = 16_000_000
 #: (:func:`measure_stride`)
 MAX_STRIDE = 32
 STRIDE_CHANGE = 0.2
-
-#: why members stopped, as the summary warning names it
-_STOPPED = {
-    Status.SINGULAR_S: "singular S",
-    Status.MASS_NOT_SPD: "mass matrix not SPD",
-    Status.NONFINITE_STATE: "non-finite state",
-    Status.DIVERGED: "diverged",
-    Status.SAMPLING_FAILED: "not placed (sampling failed)",
-    Status.STEP_TOO_SMALL: "step too small",
-    Status.MAX_STEPS: "max_steps used up",
-}
 
 
 # --------------------------------------------------------------------- sampling
@@ -265,8 +254,7 @@ def ensemble(
     if adaptive:
         pair = check.pair(None if scheme is None else check.scheme(scheme, who), who)
         scheme = pair.scheme
-        rtol = check.positive(rtol, "rtol", who)
-        atol = rtol if atol is None else check.positive(atol, "atol", who)
+        rtol, atol = check.tolerances(rtol, rtol if atol is None else atol, who)
     elif atol is not None:
         raise ValueError(f"{who}: atol is for adaptive steps; give rtol as well")
     scheme = check.scheme(scheme, who, default="rk2")
@@ -534,7 +522,7 @@ def _warn_stopped(model, status) -> None:
     stopped = Counter(int(s) for s in status[status != 0])
     if not stopped:
         return
-    reasons = ", ".join(f"{n} {_STOPPED[Status(s)]}" for s, n in sorted(stopped.items()))
+    reasons = ", ".join(f"{n} {Status(s).short}" for s, n in sorted(stopped.items()))
     total = sum(stopped.values())
     warnings.warn(
         f"ensemble({model.name}): {total} of {status.shape[0]} members stopped: {reasons}; "

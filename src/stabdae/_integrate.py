@@ -8,9 +8,9 @@ import numpy as np
 import xarray as xr
 
 from . import _validate as check
+from ._codes import Status
 from ._model import Model
 from ._schema import trajectory_dataset
-from ._status import Status
 from .engine.rk.steps import integrator_for, multipliers_for
 
 __all__ = ["integrate", "IntegrationWarning"]

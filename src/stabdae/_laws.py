@@ -20,9 +20,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba.core.dispatcher import Dispatcher
 
+from ._codes import LawKind
 from ._model import Model, ModelError, probe_output
 from .engine.jit import is_njit
-from .engine.rhs import LAW_ACPR, LAW_CONSTANT, LAW_SCALAR_BLOCKS, LAW_THEOREM5, LAW_USER
 
 __all__ = [
     "Law", "BoundLaw", "baumgarte", "matrix", "theorem5", "none", "user", "acpr", "as_law",
@@ -76,8 +76,8 @@ class Law:
         A = np.ascontiguousarray(self.A(model))
         factors = _scalar_blocks(A, model.m, model.k)
         if factors is not None and model.sparse_structure() is not None:
-            return BoundLaw(self, LAW_SCALAR_BLOCKS, factors, np.zeros(1))
-        return BoundLaw(self, LAW_CONSTANT, A, np.zeros(1))
+            return BoundLaw(self, int(LawKind.SCALAR_BLOCKS), factors, np.zeros(1))
+        return BoundLaw(self, int(LawKind.CONSTANT), A, np.zeros(1))
 
     def A_tilde(self, model: Model, x=None, t=None, p=None) -> np.ndarray:
         """The full (2m + k) × (2m + k) matrix ``Ã`` of (3.9).
@@ -216,7 +216,7 @@ class Theorem5(Law):
         )
 
     def bind(self, model: Model) -> BoundLaw:
-        return BoundLaw(self, LAW_THEOREM5, self._L(model), np.array([self.gain]))
+        return BoundLaw(self, int(LawKind.THEOREM5), self._L(model), np.array([self.gain]))
 
     def A_tilde(self, model: Model, x=None, t=None, p=None) -> np.ndarray:
         L = self._L(model)
@@ -257,7 +257,7 @@ class UserLaw(Law):
     def bind(self, model: Model) -> BoundLaw:
         p = model.default_params()
         self._evaluate(model, model.reference_state(p), model.t0, p)
-        return BoundLaw(self, LAW_USER, np.zeros((1, 1)), np.zeros(1), self.fn)
+        return BoundLaw(self, int(LawKind.USER), np.zeros((1, 1)), np.zeros(1), self.fn)
 
     def A_tilde(self, model: Model, x=None, t=None, p=None) -> np.ndarray:
         p = model.default_params() if p is None else p
@@ -296,7 +296,7 @@ class ACPR(Law):
         return self.A(model)
 
     def bind(self, model: Model) -> BoundLaw:
-        return BoundLaw(self, LAW_ACPR, np.zeros((model.r, model.n_residual)),
+        return BoundLaw(self, int(LawKind.ACPR), np.zeros((model.r, model.n_residual)),
                         np.array([self.gamma]))  # fmt: skip
 
     def attrs(self) -> dict:

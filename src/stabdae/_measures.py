@@ -35,28 +35,23 @@ import math
 
 import numpy as np
 
-from ._status import Status
+from ._codes import ProbeStage, StabilityClass, Status, TauStarReason, messages
 from .engine import decay
 
-#: class codes of ``stability_class``
-DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON, GROWING, DIVERGED, NOT_RUN = range(7)
-CLASSES = ("decayed", "overshoot", "at_floor", "floor_above_epsilon", "growing", "diverged",
-           "not_run")  # fmt: skip
+#: class codes of ``stability_class`` (:class:`stabdae._codes.StabilityClass`)
+DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON, GROWING, DIVERGED, NOT_RUN = (
+    int(c) for c in StabilityClass)
+CLASSES = tuple(c.message for c in StabilityClass)
 STABLE = (DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON)
 #: the normal quantile of the 95 % intervals
 Z95 = 1.959963984540054
 
-#: codes of a boundary search's ``tau_star_reason``
-BRACKETED, LOW_END_FAILS, HIGH_END_STABLE, CONFIRM_FAILS = range(4)
-TAU_STAR_REASONS = {
-    BRACKETED: "bracketed", LOW_END_FAILS: "not stable at the bracket's low end",
-    HIGH_END_STABLE: "stable at the bracket's high end",
-    CONFIRM_FAILS: "the full ensemble is not stable above the bracket's low end",
-}  # fmt: skip
-#: a boundary search's probe stages (``probe_stage``)
-ENDS, GUIDED, BISECTION, CONFIRM = range(4)
-STAGES = {ENDS: "bracket ends", GUIDED: "beside the spectral limit", BISECTION: "bisection",
-          CONFIRM: "full ensemble"}  # fmt: skip
+#: codes of a boundary search's ``tau_star_reason`` (:class:`stabdae._codes.TauStarReason`)
+BRACKETED, LOW_END_FAILS, HIGH_END_STABLE, CONFIRM_FAILS = (int(c) for c in TauStarReason)
+TAU_STAR_REASONS = messages(TauStarReason)
+#: a boundary search's probe stages (``probe_stage``, :class:`stabdae._codes.ProbeStage`)
+ENDS, GUIDED, BISECTION, CONFIRM = (int(c) for c in ProbeStage)
+STAGES = messages(ProbeStage)
 
 #: how far above the roundoff it can build up a rising residual must be to be growth
 ROUNDOFF_MARGIN = 10.0

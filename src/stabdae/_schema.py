@@ -27,11 +27,17 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ._measures import CLASSES, STAGES, TAU_STAR_REASONS
-from ._status import Status, status_flag_attrs
+from ._codes import (
+    BetaReason,
+    FitKind,
+    ProbeStage,
+    StabilityClass,
+    Status,
+    TauStarReason,
+    flag_attrs,
+)
 from ._vector_width import PREFER_512
 from ._version import __version__
-from .engine.decay import KINDS, REASONS
 from .engine.fma import HOST_FMA
 
 __all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "provenance",
@@ -54,12 +60,6 @@ COUNTS = ("fit_points", "diverged_step", "steps_accepted", "rhs_evaluations")
 
 _FLAG = {"flag_values": [0, 1], "flag_meanings": "no yes"}
 
-
-def _flags(names: dict) -> dict:
-    """CF flag attributes of an int8 code variable, from ``{code: meaning}``."""
-    words = [re.sub(r"[^0-9a-zA-Z]+", "_", v.split(":")[0].split(" (")[0]).strip("_")
-             for v in names.values()]  # fmt: skip
-    return {"flag_values": list(names), "flag_meanings": " ".join(words)}
 _HELD = {**_FLAG, "comment": "judged above 10x the member's residual floor, that floor added "
          "to the bound"}  # fmt: skip
 
@@ -85,7 +85,7 @@ SCHEMA: dict[str, tuple] = {
     "beta": ("member", "decay rate of the residual norm, measured at every step", "s-1",
              {"comment": "fitted on the right envelope of the transient above the floor; "
               "NaN with beta_reason where there is none"}),
-    "beta_reason": ("member", "why beta is or is not fitted", "1", _flags(REASONS)),
+    "beta_reason": ("member", "why beta is or is not fitted", "1", flag_attrs(BetaReason)),
     "gamma": ("member", "prefactor: max over the transient of |g| exp(beta t)", RESIDUAL, {}),
     "residual_floor": ("member", "largest residual norm over the last fifth of the run "
                        "(truncation floor)", RESIDUAL, {}),
@@ -100,12 +100,12 @@ SCHEMA: dict[str, tuple] = {
     "fit_end": ("member", "end of the window beta is fitted on", "s", {}),
     "fit_points": ("member", "right-envelope points in the fit window (pairs of the "
                    "one-step map)", "1", {}),
-    "fit_kind": ("member", "kind of decay fit", "1", _flags(KINDS)),
+    "fit_kind": ("member", "kind of decay fit", "1", flag_attrs(FitKind)),
     "beta_predicted": ("member", "beta of the member's linear prediction R^k alpha0 (or "
                        "exp(A~ t) alpha0), same window and fit", "s-1", {}),
     "beta_ratio": ("member", "beta / beta_predicted", "1", {}),
     "beta_ratio_median": ((), "median of beta / beta_predicted", "1", {}),
-    "stability_class": ("member", "stability class", "1", _flags(dict(enumerate(CLASSES)))),
+    "stability_class": ("member", "stability class", "1", flag_attrs(StabilityClass)),
     "stable": ("member", "decayed, overshot by the law's transient, or sat at the floor "
                "(not growing, not diverged)", "1", _FLAG),
     "bounded": ("member", "stable and within epsilon (Definition 2)", "1", _FLAG),
@@ -113,7 +113,7 @@ SCHEMA: dict[str, tuple] = {
                  _FLAG),
     "diverged_step": ("member", "step at which the member stopped (-1: ran to the end)", "1",
                       {}),
-    "status": ("member", "member status", "1", status_flag_attrs()),
+    "status": ("member", "member status", "1", flag_attrs(Status)),
     "steps_accepted": ("member", "accepted steps (adaptive steps)", "1", {}),
     "rhs_evaluations": ("member", "right-hand-side evaluations (adaptive steps)", "1", {}),
     "energy_drift": ("member", "energy change E(final) - E(x0)", ENERGY, {}),
@@ -160,7 +160,7 @@ SCHEMA: dict[str, tuple] = {
     "tau_star_low": ((), "tau_star bracket, low: stable with the full ensemble", "s", {}),
     "tau_star_high": ((), "tau_star bracket, high: not stable", "s", {}),
     "tau_star_reason": ((), "why tau_star is or is not bracketed", "1",
-                        _flags(TAU_STAR_REASONS)),
+                        flag_attrs(TauStarReason)),
     "tau_limit_floor": ((), "largest tau at which Theorems 6/7 with condition 4 bound the "
                         "residual by epsilon (the floor the local error forces)", "s", {}),
     "probe_tau": ("probe", "step size of the probe", "s", {}),
@@ -168,7 +168,7 @@ SCHEMA: dict[str, tuple] = {
     "probe_fraction_stable": ("probe", "fraction of stable members at the probe", "1", {}),
     "probe_stable": ("probe", "the probe counted as stable (fraction at least 1 - q)", "1",
                      _FLAG),
-    "probe_stage": ("probe", "stage of the search", "1", _flags(STAGES)),
+    "probe_stage": ("probe", "stage of the search", "1", flag_attrs(ProbeStage)),
     "lambda_min_W": ((), "min eigenvalue of W = h_v h_v^T over x0 and x_final", "1", {}),
     "beta_theorem5_proven": ((), "Theorem 5 rate k0 lambda_min(W) l1^2/lm (proven)", "s-1",
                              {}),
@@ -280,7 +280,21 @@ def schema_markdown() -> str:
             unit = _MARKER_TEXT.get(units, f"`{units}`")
             meaning = long_name.replace("|", "\\|")
             out.append(f"| `{shown}` | ({', '.join(dims)}) | {unit} | {meaning} |")
+    out += ["", "## Codes", "",
+            "Every integer code a dataset stores, with its message (`stabdae._codes`; each",
+            "code variable's `flag_values` and `flag_meanings` come from the same table)."]
+    for variable, family in _CODE_VARIABLES:
+        out += ["", f"### `{variable}` — `{family.__name__}`", "", "| value | name | meaning |",
+                "|---|---|---|"]
+        out += [f"| {int(c)} | `{c.name}` | {c.message.replace('|', chr(92) + '|')} |"
+                for c in family]
     return "\n".join(out) + "\n"
+
+
+#: the stored code variables and their families, as the schema page lists them
+_CODE_VARIABLES = (("status", Status), ("beta_reason", BetaReason), ("fit_kind", FitKind),
+                   ("stability_class", StabilityClass), ("tau_star_reason", TauStarReason),
+                   ("probe_stage", ProbeStage))  # fmt: skip
 
 
 # --------------------------------------------------------------------- units
@@ -496,7 +510,7 @@ def trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, r
     attrs = provenance(model, p, law, scheme, f"{action}: one trajectory", **run)
     status = Status(status)
     attrs.update(status=int(status), status_name=status.name.lower(), steps_completed=done)
-    attrs.update({f"status_{k}": v for k, v in status_flag_attrs().items()})
+    attrs.update({f"status_{k}": v for k, v in flag_attrs(Status).items()})
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -16,10 +16,11 @@ import math
 
 import numpy as np
 
+from ._codes import LawKind
 from ._laws import Law, LawError, as_law, bind_law
 from ._model import Model, ModelError
 from ._schemes import EmbeddedPair, Scheme, SchemeError, as_scheme, embedded_pair
-from .engine.rhs import LAW_ACPR, MULTIPLIERS, PROJECTIONS
+from .engine.rhs import MULTIPLIERS, PROJECTIONS
 
 __all__ = [
     "block", "bound_law", "choice", "count", "dtype", "fixed_time_grid", "initial_state",
@@ -106,6 +107,20 @@ def positive(value, name: str, who: str) -> float:
     if not (math.isfinite(out) and out > 0):
         raise ValueError(f"{who}: {name} must be positive and finite, got {value!r}")
     return out
+
+
+def tolerances(rtol, atol, who: str) -> tuple[float, float]:
+    """The adaptive steps' ``(rtol, atol)``, one rule for every caller: both positive and
+    finite, ``rtol`` at least 100 machine epsilons (below it the error estimate is
+    roundoff, and the step size would shrink without end)."""
+    rtol = positive(rtol, "rtol", who)
+    atol = positive(atol, "atol", who)
+    if rtol < 100 * np.finfo(float).eps:
+        raise ValueError(
+            f"{who}: rtol = {rtol:g} is below 100 machine epsilons "
+            f"({100 * np.finfo(float).eps:.1e}); the error estimate is roundoff"
+        )
+    return rtol, atol
 
 
 def count(value, name: str, who: str) -> int:
@@ -268,7 +283,7 @@ def radius(value, who: str) -> tuple[float, float]:
 
 def multiplier(value, bound, who: str) -> str:
     choice(value, "multiplier", MULTIPLIERS, who)
-    if bound.code == LAW_ACPR and value != "ldl":
+    if bound.code == LawKind.ACPR and value != "ldl":
         raise LawError(
             f"{who}: the acpr correction uses the L D Lᵀ factor of S; multiplier must be "
             f"'ldl', got {value!r}"

@@ -35,12 +35,11 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 from types import SimpleNamespace
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
-from .._status import Status
+from .._codes import LawKind, Status
 from .cache import fingerprint, memo, optional_fingerprint, tag
 from .fma import fma
 from .jit import python_function
@@ -62,19 +61,16 @@ from .linalg import (
 )
 from .workspace import builders
 
-if TYPE_CHECKING:
-    from .._laws import BoundLaw
-    from .._model import Model
-
-# Compile-time law kinds of the right-hand side (a law binds to one, :mod:`stabdae._laws`)
-LAW_CONSTANT = 0  # A given as a runtime matrix
-LAW_THEOREM5 = 1  # A22 = −k W(x) L,  W = h_v h_vᵀ  (m = 0)
-LAW_USER = 2  # A(t, x, p, out) evaluated in the kernel
-LAW_ACPR = 3  # A = 0 plus the correction −γ_s D (G D)⁻¹ g of Ascher, Chin, Petzold, Reich
+# Compile-time law kinds of the right-hand side, as plain ints (the table, with what each
+# means, is :class:`stabdae._codes.LawKind`; a law binds to one, :mod:`stabdae._laws`)
+LAW_CONSTANT = int(LawKind.CONSTANT)
+LAW_THEOREM5 = int(LawKind.THEOREM5)  # A22 = −k W(x) L,  W = h_v h_vᵀ  (m = 0)
+LAW_USER = int(LawKind.USER)
+LAW_ACPR = int(LawKind.ACPR)  # A = 0 plus the correction −γ_s D (G D)⁻¹ g
 #: a constant A whose blocks are multiples of the identity (Baumgarte's), given by its three
 #: factors (f, ḟ, h) as a 1 × 3 matrix: the same sums as LAW_CONSTANT without their zero
 #: terms (bound so only for the sparse path, where r × (2m + k) products would dominate)
-LAW_SCALAR_BLOCKS = 4
+LAW_SCALAR_BLOCKS = int(LawKind.SCALAR_BLOCKS)
 
 # Relative pivot thresholds of the L D Lᵀ factorizations: a pivot below RTOL·max|diag|
 # reports a singular matrix instead of producing huge or NaN multipliers.
@@ -173,7 +169,7 @@ def _rejit(fn, absent):
     return njit(error_model="numpy", forceinline=True)(python_function(fn))
 
 
-def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kernels:
+def kernels_for(model, bound, multiplier: str = "ldl") -> Kernels:
     """Compiled ``rhs``, ``residual`` and ``energy`` for ``model`` under the law's kind.
 
     Memoized on the model, since every new closure is a new compilation.  Numeric law data
@@ -184,7 +180,7 @@ def kernels_for(model: Model, bound: BoundLaw, multiplier: str = "ldl") -> Kerne
                 lambda: _build(model, bound.code, bound.fn, multiplier == "lstsq"))
 
 
-def _pieces(model: Model, sparse: bool) -> SimpleNamespace:
+def _pieces(model, sparse: bool) -> SimpleNamespace:
     """The compiled pieces of ``model`` that no law touches: its functions with the
     library's flags, the workspace, ``residual``, ``project``, ``energy`` (and the sparse
     path's helpers where ``sparse``), shared by the kernels of every law kind (the sampler
@@ -375,7 +371,7 @@ def _nested(a) -> tuple:
     return tuple(tuple(bool(v) for v in row) for row in a)
 
 
-def _structured(model: Model, n: int, m: int, k: int) -> SimpleNamespace | None:
+def _structured(model, n: int, m: int, k: int) -> SimpleNamespace | None:
     """The dense path's linear algebra written out for the model's structural zeros.
 
     A mass matrix that is not diagonal rules out the sparse path (:mod:`.sparsity`), but
@@ -448,7 +444,7 @@ def _structured(model: Model, n: int, m: int, k: int) -> SimpleNamespace | None:
     )
 
 
-def _build(model: Model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
+def _build(model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     # The sparse path (:mod:`.sparsity`) where the model's structure pays for it; not for
     # the least-squares multiplier or the correction of Ascher et al., which stay dense.
     sparse = not (lstsq or law_code == LAW_ACPR) and model.sparse_structure() is not None

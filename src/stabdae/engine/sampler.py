@@ -19,7 +19,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .._status import Status
+from .._codes import Status
 from .cache import kernel_key, keyed_cache, memo, tag
 from .linalg import ldl_inplace, ldl_solve_inplace
 from .rhs import LAW_CONSTANT, kernels_for

@@ -55,7 +55,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..._status import Status
+from ..._codes import Status
 from ..cache import kernel_key, keyed_cache, memo, tag
 from ..decay import (
     MAP_MAX_NG,

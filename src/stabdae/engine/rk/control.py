@@ -17,7 +17,7 @@ import math
 
 from numba import njit
 
-from ..._status import Status
+from ..._codes import Status
 
 #: the step-size update ``SAFETY · err^{−1/(q+1)}``, kept within ``[MIN_FACTOR, MAX_FACTOR]``
 SAFETY = 0.9

@@ -1,0 +1,180 @@
+"""Every integer code stabdae returns or stores, each with one message: the table.
+
+A family of codes is an :class:`enum.IntEnum` whose members are declared with their
+message, ``NAME = value, "message"``.  The kernels return and store the integers (they
+read them as plain ints, ``int(Status.OK)``); the drivers, the summaries, the warnings,
+the dataset's CF attributes (``flag_values``/``flag_meanings``, :func:`flag_attrs`) and
+the schema page all read the messages from here, so that a code has one meaning
+everywhere.  The values are part of the dataset schema: they never change meaning; a new
+code takes a new value.
+
+Families: :class:`Status` (a right-hand side's evaluation or a member's integration),
+:class:`BetaReason` (why a member has a decay rate or not), :class:`FitKind` (which fit
+gave it), :class:`StabilityClass` (a member's class), :class:`TauStarReason` (how a
+boundary search ended), :class:`ProbeStage` (a boundary search's probes) and
+:class:`LawKind` (how the right-hand side evaluates the law: compile-time, never stored).
+
+To add a code: a member with the next free value and its message in its family.  The
+flag attributes and the schema page follow; a kernel that returns it compares with
+``int(Family.NAME)``.
+"""
+
+from __future__ import annotations
+
+import re
+from enum import IntEnum
+
+__all__ = ["BetaReason", "FitKind", "LawKind", "ProbeStage", "Status", "StabilityClass",
+           "TauStarReason", "flag_attrs"]  # fmt: skip
+
+
+class _Codes(IntEnum):
+    """A family of codes: ``NAME = value, "message"``."""
+
+    def __new__(cls, value: int, message: str):
+        member = int.__new__(cls, value)
+        member._value_ = value
+        member.message = message
+        return member
+
+    @property
+    def flag_meaning(self) -> str:
+        """The CF ``flag_meanings`` word: the message up to its first colon or bracket,
+        non-alphanumerics as underscores."""
+        head = self.message.split(":")[0].split(" (")[0]
+        return re.sub(r"[^0-9a-zA-Z]+", "_", head).strip("_")
+
+
+class Status(_Codes):
+    """Outcome of a right-hand-side evaluation or of one member's integration.
+
+    Kernels never raise: every right-hand-side evaluation and every integration returns
+    one of these, and the Python wrapper turns a non-zero code into a warning, an error or
+    a per-member flag (variable ``status``)."""
+
+    #: finished normally
+    OK = 0, "ok"
+    #: ``S = F M⁻¹ Fᵀ`` is singular or not finite: redundant or degenerate constraints (3.11)
+    SINGULAR_S = 1, ("singular constraint matrix S = F M^-1 F^T (redundant or degenerate "
+                     "constraints) in the multiplier equation (3.11)")
+    #: the mass matrix is not symmetric positive definite (or not finite)
+    MASS_NOT_SPD = 2, "mass matrix is not symmetric positive definite"
+    #: the state became non-finite (NaN or inf) during a step
+    NONFINITE_STATE = 3, "state became non-finite (NaN or inf)"
+    #: the residual norm exceeded the divergence threshold
+    DIVERGED = 4, "residual norm exceeded the divergence threshold"
+    #: the initial state could not be placed at the requested perturbation
+    SAMPLING_FAILED = 5, "initial perturbation could not be reached by Gauss-Newton"
+    #: adaptive integration: the step size fell below roundoff of the time
+    STEP_TOO_SMALL = 6, ("adaptive step size fell below roundoff of the time (stiff, "
+                         "singular or non-finite right-hand side)")
+    #: adaptive integration: the step budget (max_steps) was used up
+    MAX_STEPS = 7, "adaptive integration used up max_steps"
+
+    @property
+    def description(self) -> str:
+        return self.message
+
+    @property
+    def flag_meaning(self) -> str:
+        return self.name.lower()
+
+    @property
+    def short(self) -> str:
+        """The few words a summary warning counts members by."""
+        return _STATUS_SHORT[self]
+
+
+_STATUS_SHORT = {
+    Status.OK: "ok",
+    Status.SINGULAR_S: "singular S",
+    Status.MASS_NOT_SPD: "mass matrix not SPD",
+    Status.NONFINITE_STATE: "non-finite state",
+    Status.DIVERGED: "diverged",
+    Status.SAMPLING_FAILED: "not placed (sampling failed)",
+    Status.STEP_TOO_SMALL: "step too small",
+    Status.MAX_STEPS: "max_steps used up",
+}
+
+
+class BetaReason(_Codes):
+    """Why a member has a fitted decay rate, or why not (``beta_reason``)."""
+
+    FITTED = 0, "fitted"
+    NO_TRANSIENT = 1, "no transient: under a decade of decay above the floor"
+    STOPPED = 2, "stopped"
+    NOT_DECAYING = 3, "not decaying"
+
+
+class FitKind(_Codes):
+    """Which fit gave a member's decay rate (``fit_kind``)."""
+
+    NONE = 0, "none"
+    EXPONENTIAL = 1, "exponential"
+    POLYNOMIAL = 2, "exponential with polynomial prefactor"
+    OSCILLATING = 3, "oscillating (level times regressed on levels)"
+    MAP = 4, "one-step map (spectral radius of the fitted g_k -> g_k+1)"
+
+
+class StabilityClass(_Codes):
+    """A member's stability class (``stability_class``)."""
+
+    DECAYED = 0, "decayed"
+    OVERSHOOT = 1, "overshoot"
+    AT_FLOOR = 2, "at_floor"
+    FLOOR_ABOVE_EPSILON = 3, "floor_above_epsilon"
+    GROWING = 4, "growing"
+    DIVERGED = 5, "diverged"
+    NOT_RUN = 6, "not_run"
+
+
+class TauStarReason(_Codes):
+    """How a boundary search ended (``tau_star_reason``)."""
+
+    BRACKETED = 0, "bracketed"
+    LOW_END_FAILS = 1, "not stable at the bracket's low end"
+    HIGH_END_STABLE = 2, "stable at the bracket's high end"
+    CONFIRM_FAILS = 3, "the full ensemble is not stable above the bracket's low end"
+
+
+class ProbeStage(_Codes):
+    """The stage of a boundary search a probe belongs to (``probe_stage``)."""
+
+    ENDS = 0, "bracket ends"
+    GUIDED = 1, "beside the spectral limit"
+    BISECTION = 2, "bisection"
+    CONFIRM = 3, "full ensemble"
+
+
+class LawKind(_Codes):
+    """How the stabilized right-hand side evaluates a law's ``Ã``: a kernel is compiled per
+    kind (a law binds to one, :mod:`stabdae._laws`); never stored in a dataset.
+
+    Adding a law kind: a member here; its branch in ``stabdae.engine.rhs`` (how ``A g`` is
+    formed from the bound law's run-time ``matrix`` and ``scalars``, or from its compiled
+    function: nothing else reaches the kernel); a ``Law`` in ``stabdae._laws`` whose
+    ``bind`` returns ``BoundLaw(self, int(LawKind.X), matrix, scalars[, fn])`` and whose
+    ``A_tilde`` gives the full ``Ã`` (the theory and the tests' NumPy right-hand side
+    read it); its keys in study files (``stabdae.study.spec``); a test of ``ġ = Ã g``
+    against the exact solution or the NumPy reference right-hand side."""
+
+    CONSTANT = 0, "a constant A, given as a run-time matrix"
+    THEOREM5 = 1, "Theorem 5's A22 = -k W(x) L with W = h_v h_v^T (no holonomic constraint)"
+    USER = 2, "a user function A(t, x, p, out) evaluated in the kernel"
+    ACPR = 3, ("A = 0 plus the correction -gamma_s D (G D)^-1 g of Ascher, Chin, Petzold "
+               "and Reich")
+    #: a constant A whose blocks are multiples of the identity (Baumgarte's), given by its
+    #: three factors (f, ḟ, h) as a 1 × 3 matrix: the same sums as CONSTANT without their
+    #: zero terms (bound so only for the sparse path)
+    SCALAR_BLOCKS = 4, "a constant A of scalar blocks, given by its three factors"
+
+
+def flag_attrs(codes: type[_Codes]) -> dict:
+    """CF ``flag_values`` and ``flag_meanings`` of a code variable of the family ``codes``."""
+    return {"flag_values": [int(c) for c in codes],
+            "flag_meanings": " ".join(c.flag_meaning for c in codes)}  # fmt: skip
+
+
+def messages(codes: type[_Codes]) -> dict[int, str]:
+    """``{code: message}`` of a family."""
+    return {int(c): c.message for c in codes}
