@@ -85,7 +85,7 @@ def test_unreachable_scheduler_and_unwritable_output_give_one_line(tmp_path, mon
     naming the address or the folder, exit 2, before anything is computed."""
     import os
 
-    from test_run import study_file
+    from conftest import study_file
 
     study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
     env = dict(os.environ, DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT="1s")
@@ -114,7 +114,7 @@ def test_unreachable_scheduler_and_unwritable_output_give_one_line(tmp_path, mon
 def test_run_output_folder_orphans_and_foreign_files(tmp_path):
     """-o with a folder writes <study>.nc inside it; a temporary file left by a killed write
     is removed; a file that is not a stabdae dataset is not replaced, even with --force."""
-    from test_run import study_file
+    from conftest import study_file
 
     study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
     folder = tmp_path / "outdir"
@@ -157,7 +157,7 @@ def test_integrate_with_rk3_and_with_a_tableau(tmp_path, capsys):
 def test_progress_says_compiling_until_the_kernels_are_ready(tmp_path, capsys):
     """The progress bar reads "compiling" until the first members are done (no estimate
     of hours from a rate of zero), then how long the kernels took."""
-    from test_run import study_file
+    from conftest import study_file
 
     study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
     assert main(["run", str(study), "--no-plots"]) == 0

@@ -1,7 +1,7 @@
 """The other stabilizations of the toolkit: Ascher–Chin–Petzold–Reich (ACPR), post-
 stabilization and coordinate projection (the end of the paper's §3).
 
-References: on the affine system of tests/affine.py the ACPR residual obeys a linear law
+References: on the affine system of tests/models/affine.py the ACPR residual obeys a linear law
 whose matrix is derived by hand below, so one RK step maps g by the scheme's stability
 polynomial exactly; a projection lands on the manifold (invariant g = 0), radially for the
 pendulum (the closest point of the circle, closed form); projection does not change the
@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from affine import model as affine
 from scipy.linalg import expm
 
 import stabdae
 from conftest import load_scene, perturbed_state
+from models.affine import model as affine
 from stabdae._laws import LawError, bind_law
 from stabdae.engine.rhs import kernels_for
 from stabdae.theory import step_matrix

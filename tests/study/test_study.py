@@ -279,12 +279,12 @@ def test_moved_tau_values_are_reported(tmp_path, capsys):
     assert "the residual is gone after 1 step" in out
 
 
-@pytest.mark.parametrize("name", sorted(p.name for p in (Path(__file__).resolve().parents[1]
+@pytest.mark.parametrize("name", sorted(p.name for p in (Path(__file__).resolve().parents[2]
                                                         / "studies").glob("*.toml")))  # fmt: skip
 def test_shipped_studies_load_from_the_repository_root(name, monkeypatch):
     """The study files the README and docs run validate as they are run (from the
     repository's root: their output goes to results/ there)."""
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     monkeypatch.chdir(root)
     study = load_study(root / "studies" / name)
     assert study.output == root / "results" / name.replace(".toml", ".nc")

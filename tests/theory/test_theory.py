@@ -174,9 +174,10 @@ def test_theorem5_constants_and_law_with_two_constraints_and_L_not_identity():
     """Two nonholonomic constraints, W = diag(9, 4), L with eigenvalues 1/2 and 2: Theorem
     5's rates in closed form (proven k·λ_min(W)·l₁²/l_m = k/2, printed k·w₀·l₁²/l_m = k/4),
     and the residual following ḣ = −k W L h, i.e. expm(−k W L t) h(0)."""
-    from linear_nonholonomic import W
-    from linear_nonholonomic import model as lin
     from scipy.linalg import expm
+
+    from models.linear_nonholonomic import W
+    from models.linear_nonholonomic import model as lin
 
     c, s = math.cos(0.4), math.sin(0.4)
     Q = np.array([[c, -s], [s, c]])

@@ -8,7 +8,7 @@ from numba import njit
 
 import stabdae
 from conftest import load_scene
-from toy import unit_pendulum
+from models.toy import unit_pendulum
 
 # ---------------------------------------------------------------- a pendulum to break
 

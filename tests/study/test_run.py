@@ -16,59 +16,13 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from conftest import assert_schema
+from conftest import STUDY, assert_schema, same_data, study_file
 from stabdae._schema import write_netcdf
 from stabdae.study.cli import main
 from stabdae.study.run import run_study
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "src"
-
-STUDY = """
-[model]
-file = "pendulum"
-
-[law]
-kind = "baumgarte"
-omega = 10.0
-xi = 1.0
-
-[scheme]
-name = "rk2"
-
-[run]
-t_end = {t_end}
-tau = 1e-3
-save_dt = 0.05
-epsilon = 1.0
-
-[ensemble]
-members = {members}
-radius = [1e-6, 1e-3]
-seed = 3
-
-[sweep]
-tau = [5e-4, 1e-3, 0.01, 0.05, 0.1, 0.2]
-omega = [{omegas}]
-
-[output]
-path = "out/study.nc"
-"""
-
-
-def study_file(tmp_path, members=64, t_end=1.0, omegas="5.0, 30.0", name="study.toml"):
-    path = tmp_path / name
-    path.write_text(STUDY.format(members=members, t_end=t_end, omegas=omegas))
-    return path
-
-
-def same_data(a: xr.Dataset, b: xr.Dataset):
-    """Identical variables, coordinates and attributes, but for when it was made."""
-    for ds in (a, b):
-        for key in ("created_at", "wall_run_s", "history"):
-            ds.attrs.pop(key, None)
-    xr.testing.assert_identical(a, b)
-
 
 def test_run_writes_dataset_and_pictures_and_refuses_to_overwrite(tmp_path, capsys):
     path = study_file(tmp_path)

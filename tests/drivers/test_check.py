@@ -8,7 +8,7 @@ from numba import njit
 
 import stabdae
 from conftest import SCENES, load_scene
-from toy import X_REF, unit_pendulum
+from models.toy import X_REF, unit_pendulum
 
 KNIFE = load_scene("knife_edge")
 

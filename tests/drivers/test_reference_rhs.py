@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from reference.rhs import stabilized_rhs
 
 import stabdae
 from conftest import SCENES, load_scene, perturbed_state, rhs_function
+from reference.rhs import stabilized_rhs
 
 LAWS = {
     "baumgarte": lambda model: stabdae.baumgarte(10.0, 0.7, k=3.0),

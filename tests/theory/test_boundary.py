@@ -9,10 +9,10 @@ import warnings
 
 import numpy as np
 import pytest
-from affine import model as affine
 
 import stabdae
 from conftest import assert_schema, load_scene
+from models.affine import model as affine
 from stabdae import theory
 from stabdae._measures import BRACKETED, CLASSES, HIGH_END_STABLE, LOW_END_FAILS
 

@@ -1,0 +1,147 @@
+"""Adaptive ensembles: members on lanes with their own steps, bit-identical to
+integrate_adaptive, refilled lanes, divergence isolated, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import stabdae
+from conftest import load_scene
+from stabdae.engine import decay
+
+
+# ---------------------------------------------------------------- adaptive steps per member
+@pytest.mark.parametrize("pair", ["dopri5", "dop853"])
+def test_adaptive_members_control_their_own_steps(pair):
+    """Pendulums swinging at different amplitudes need different numbers of steps; each
+    member is bit-for-bit the single adaptive integration from its start, with either
+    embedded pair."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    angles = np.array([0.1, 0.8, 1.6, 2.6])
+    x0 = np.stack([[np.sin(a), -np.cos(a), 0.0, 0.0] for a in angles])
+    kw = dict(rtol=1e-8, atol=1e-10, save_dt=0.5, residual_dtype="float64")
+    ds = stabdae.ensemble(model, law, pair, tau=1e-3, t_end=2.0, x0=x0, **kw)
+    assert ds.attrs["method"] == f"{pair}-adaptive" and ds.attrs["first_step"] == 1e-3
+    steps = ds.steps_accepted.values
+    assert len(set(steps.tolist())) == len(angles), steps  # every member its own count
+    for j in range(len(angles)):
+        one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, scheme=pair, rtol=1e-8,
+                                         atol=1e-10, save_dt=0.5, first_step=1e-3)  # fmt: skip
+        assert one.attrs["method"] == pair and one.attrs["steps_accepted"] == steps[j]
+        assert one.attrs["rhs_evaluations"] == ds.rhs_evaluations.values[j]
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+        np.testing.assert_array_equal(ds.residual_norm.values[j], one.residual_norm.values)
+
+
+@pytest.mark.parametrize("pair", ["dopri5", "dop853"])
+def test_adaptive_lanes_refill_and_stay_bit_identical(pair):
+    """Members of very different step counts (at rest to spinning at 100 rad/s) on three
+    lanes, five or so members per work item (so lanes are refilled): a lane whose member
+    has ended takes the next waiting one, and every member is still the single adaptive
+    integration bit for bit; a member that cannot start (singular S) stops alone; nothing
+    depends on the lanes or the threads."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    angles = np.linspace(0.05, 3.0, 35)
+    spins = np.random.default_rng(3).permutation(np.r_[0.0, np.geomspace(0.1, 100.0, 34)])
+    x0 = np.stack([[np.sin(a), -np.cos(a), w * np.cos(a), w * np.sin(a)]
+                   for a, w in zip(angles, spins)])  # fmt: skip
+    x0 = np.insert(x0, 4, [0.0, 0.0, 0.1, 0.0], axis=0)  # the rod of length 0: S = 0
+    kw = dict(tau=1e-3, t_end=2.0, x0=x0, rtol=1e-8, atol=1e-10, save_dt=0.25,
+              residual_dtype="float64", traces="all")  # fmt: skip
+    with pytest.warns(stabdae.IntegrationWarning, match="1 singular S"):
+        ds = stabdae.ensemble(model, law, pair, block=3, threads=1, **kw)
+    assert ds.status.values[4] == stabdae.Status.SINGULAR_S
+    good = [j for j in range(len(x0)) if j != 4]
+    steps = ds.steps_accepted.values[good]
+    assert steps.max() >= 4 * steps.min(), steps
+    for j in good:
+        one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, scheme=pair, rtol=1e-8,
+                                         atol=1e-10, save_dt=0.25, first_step=1e-3)  # fmt: skip
+        assert one.attrs["steps_accepted"] == ds.steps_accepted.values[j]
+        assert one.attrs["rhs_evaluations"] == ds.rhs_evaluations.values[j]
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+        np.testing.assert_array_equal(ds.residual_norm.values[j], one.residual_norm.values)
+    with pytest.warns(stabdae.IntegrationWarning):
+        other = stabdae.ensemble(model, law, pair, block=8, threads=2, **kw)
+    for name in ("residual_norm", "x_final", "steps_accepted", "rhs_evaluations", "beta",
+                 "residual_floor", "status"):  # fmt: skip
+        np.testing.assert_array_equal(ds[name].values, other[name].values)
+
+
+def test_adaptive_prediction_wakes_no_lapack_solve(monkeypatch):
+    """The adaptive ensemble's prediction propagator ``e^{Ãh}`` is formed by matrix
+    products only: LAPACK's solves (``scipy.linalg.expm`` makes them) wake the BLAS
+    library's threads, which then spin on the cores the ensemble's threads run on.
+    Every member still gets a predicted β, at the law's rate ω = 10."""
+    import scipy.linalg
+
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a LAPACK solve in the ensemble's own path")
+
+    for mod, name in ((scipy.linalg, "expm"), (scipy.linalg, "solve"),
+                      (scipy.linalg, "lu_factor"), (np.linalg, "solve"), (np.linalg, "inv")):
+        monkeypatch.setattr(mod, name, refuse)
+    ds = stabdae.ensemble(model, law, "dopri5", tau=1e-3, t_end=2.0, members=16,
+                          radius=(1e-6, 1e-3), seed=2, rtol=1e-8, atol=1e-10)  # fmt: skip
+    fitted = ds.beta_reason.values == decay.R_FITTED
+    assert fitted.sum() >= 12
+    np.testing.assert_allclose(ds.beta_predicted.values[fitted], 10.0, rtol=0.01)
+
+
+def test_expm_by_products_is_scipys_to_roundoff():
+    """``theory._expm`` (products only) against SciPy's Padé ``expm``: a critically
+    damped law over one prediction step, a stiff one, a random 6 × 6 and zero."""
+    import scipy.linalg
+
+    from stabdae import theory
+
+    rng = np.random.default_rng(4)
+    cases = [np.array([[0.0, 1.0], [-100.0, -20.0]]) * 2.4e-3,
+             np.array([[0.0, 7.3e-6], [-730.0, -0.146]]), 3.0 * rng.normal(size=(6, 6)),
+             np.zeros((3, 3))]  # fmt: skip
+    for A in cases:
+        ref = scipy.linalg.expm(A)
+        assert np.abs(theory._expm(A) - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
+def test_adaptive_ensemble_beta_and_determinism():
+    """Continuous-time decay: at tight tolerance the median fitted β is the Theorem 3 rate
+    (no discrete prediction is stored); one or two threads give the same numbers."""
+    model = load_scene("double_pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    kw = dict(tau=1e-3, t_end=3.0, members=64, radius=(1e-6, 1e-3), seed=5, save_dt=0.01,
+              rtol=1e-10, atol=1e-13)  # fmt: skip
+    a = stabdae.ensemble(model, law, threads=1, **kw)
+    b = stabdae.ensemble(model, law, threads=2, **kw)
+    assert abs(float(a.beta_median) / float(a.beta_theory) - 1.0) < 0.02
+    assert "beta_theory_discrete" not in a
+    for name in ("residual_norm", "x_final", "steps_accepted"):
+        np.testing.assert_array_equal(a[name].values, b[name].values)
+
+
+def test_adaptive_ensemble_isolates_divergence():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    good, _, _ = stabdae.sample_perturbations(model, 3, (1e-4, 1e-3), seed=1)
+    singular = np.array([0.0, 0.0, 0.1, 0.0])
+    kw = dict(tau=1e-3, t_end=0.5, rtol=1e-8, save_dt=0.05, residual_dtype="float64")
+    a = stabdae.ensemble(model, law, x0=np.vstack([good[:1], singular, good[1:]]), **kw)
+    b = stabdae.ensemble(model, law, x0=good, **kw)
+    np.testing.assert_array_equal(a.residual_norm.values[[0, 2, 3]], b.residual_norm.values)
+    assert a.status.values[1] == stabdae.Status.SINGULAR_S and a.diverged.values[1] == 1
+
+
+def test_adaptive_ensemble_errors():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    with pytest.raises(ValueError, match=r"^ensemble: adaptive steps need an embedded pair, "
+                       r"'dopri5' \(Dormand–Prince 5\(4\)\) or 'dop853' .*; got 'rk4'"):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, rtol=1e-6)
+    with pytest.raises(ValueError, match="^ensemble: atol is for adaptive steps; give rtol"):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=4, atol=1e-6)

@@ -1,0 +1,73 @@
+"""Every argument error names the function the user called."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import stabdae
+from conftest import pendulum_scene
+from stabdae import theory
+
+
+def _bad_calls():
+    law = stabdae.baumgarte(10.0)
+    m = pendulum_scene
+    return [
+        ("integrate", lambda: stabdae.integrate("pendulum", None, law)),
+        ("integrate", lambda: stabdae.integrate(m(), None, None)),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, "rk9")),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, tau=-1.0)),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, tau=0.3, t_end=1.0)),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, save_dt=0.0015)),
+        ("integrate", lambda: stabdae.integrate(m(), np.zeros(3), law)),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, params={"nope": 1.0})),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, multiplier="qr")),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, projection="half")),
+        ("integrate", lambda: stabdae.integrate(m(), None, stabdae.matrix(np.zeros((2, 2))))),
+        ("integrate", lambda: stabdae.integrate(m(), None, law, t_end="soon")),
+        ("integrate_adaptive", lambda: stabdae.integrate_adaptive(m(), None, None)),
+        ("integrate_adaptive", lambda: stabdae.integrate_adaptive(m(), None, law, rtol=0.0)),
+        ("integrate_adaptive", lambda: stabdae.integrate_adaptive(m(), None, law, t_end=-1)),
+        ("integrate_adaptive", lambda: stabdae.integrate_adaptive(m(), None, law,
+                                                                  max_steps=0)),
+        ("integrate_adaptive", lambda: stabdae.integrate_adaptive(m(), np.ones(5), law)),
+        ("integrate_adaptive", lambda: stabdae.integrate_adaptive(m(), None, law,
+                                                                  params=[1.0])),
+        ("ensemble", lambda: stabdae.ensemble(m(), None)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, tau=0.0)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, members=0)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, radius=(1.0, 0.1))),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, seed=np.random.default_rng(1))),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, seed=-1)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, x0=np.zeros((2, 3)))),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, block=0)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, block=10**6)),  # past the stack
+        ("ensemble", lambda: stabdae.ensemble(m(), law, threads=0)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, residual_dtype="float16")),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, epsilon=-1.0)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, "rk4", rtol=1e-6)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, atol=1e-6)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, "nope")),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, params={"g": "x"})),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, progress=3)),
+        ("sample_perturbations", lambda: stabdae.sample_perturbations(m(), 0)),
+        ("sample_perturbations", lambda: stabdae.sample_perturbations(m(), 4, radius=-1.0)),
+        ("sample_perturbations", lambda: stabdae.sample_perturbations(m(), 4, seed=1.5)),
+        ("sample_perturbations", lambda: stabdae.sample_perturbations(m(), 4, threads=-2)),
+        ("sample_perturbations", lambda: stabdae.sample_perturbations(m(), 4,
+                                                                      params={"l": -np.inf})),
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("index", range(len(_bad_calls())))
+def test_every_argument_error_names_the_function_called(index):
+    who, call = _bad_calls()[index]
+    with pytest.raises((ValueError, TypeError)) as info:
+        call()
+    assert str(info.value).startswith(f"{who}: "), str(info.value)
+
+
+def test_tau_limit_names_an_unknown_condition():
+    with pytest.raises(ValueError, match=r"tau_limit: condition must be one of .*'spectral'"):
+        theory.tau_limit(np.array([[-1.0]]), "euler", condition="spectal")

@@ -1,0 +1,323 @@
+"""Ensembles: members equal to single integrations bit for bit for any block, thread
+count and tableau pattern, divergence isolated, stopped members, the dataset and its
+NetCDF round trip, optional traces and states."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+import xarray as xr
+from numba import njit
+
+import stabdae
+from conftest import ROOT, assert_schema, baumgarte_ensemble, load_scene
+from stabdae._schema import write_netcdf
+from stabdae.engine.ensemble.block import CHECKPOINT
+from stabdae.engine.fma import HOST_FMA
+
+
+def test_members_equal_single_integrations_bit_for_bit():
+    model = load_scene("double_pendulum")
+    law = stabdae.baumgarte(20.0, 1.0)
+    ds = stabdae.ensemble(model, law, "heun", 1e-3, 0.5, members=5, seed=2, save_dt=0.05)
+    for j in range(5):
+        one = stabdae.integrate(model, ds.x0.values[j], law, "heun", 1e-3, 0.5, 0.05)
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+        np.testing.assert_array_equal(ds.residual_norm.values[j],
+                                      one.residual_norm.values.astype(np.float32))  # fmt: skip
+
+
+def test_block_size_does_not_change_any_number():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    runs = [stabdae.ensemble(model, law, "rk4", 1e-3, 0.2, members=37, seed=4, block=b)
+            for b in (16, 64)]  # fmt: skip
+    for other in runs[1:]:
+        for name in ("residual_norm", "x_final", "beta", "alpha0"):
+            np.testing.assert_array_equal(runs[0][name].values, other[name].values)
+
+
+_THREADS_SCRIPT = """
+import json, sys, numpy as np, numba, stabdae
+model = stabdae.load_model(sys.argv[1])
+ds = stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 1e-3, 0.3,
+                      members=300, seed=9, block=16)
+print(json.dumps({"threads": numba.get_num_threads(),
+                  "wide": ds.attrs["prefer_512_bit_vectors"],
+                  "features": numba.config.CPU_FEATURES or "",
+                  "x": ds.x_final.values.tobytes().hex(),
+                  "r": ds.residual_norm.values.tobytes().hex()}))
+"""
+
+
+def test_thread_count_and_vector_width_do_not_change_any_number():
+    """One thread or two, 512-bit SIMD vectors (where the CPU has AVX-512) or the
+    compiler's default width: the same bits."""
+    from numba.core.codegen import get_host_cpu_features
+
+    out = {}
+    base = {k: v for k, v in os.environ.items()
+            if k not in ("STABDAE_VECTOR_WIDTH", "NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME")}
+    for run, env in (("1", dict(base, NUMBA_NUM_THREADS="1")),
+                     ("2", dict(base, NUMBA_NUM_THREADS="2")),
+                     ("256", dict(base, NUMBA_NUM_THREADS="2", STABDAE_VECTOR_WIDTH="256"))):
+        proc = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT,
+                               str(ROOT / "kernels" / "pendulum.py")],
+                              capture_output=True, text=True, env=env, check=True)  # fmt: skip
+        out[run] = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["1"]["threads"] == 1
+    avx512 = "+avx512f" in get_host_cpu_features().split(",")
+    assert out["2"]["wide"] == int(avx512) and out["256"]["wide"] == 0
+    assert ("-prefer-256-bit" in out["2"]["features"]) == avx512
+    assert "-prefer-256-bit" not in out["256"]["features"]
+    for other in ("2", "256"):
+        assert out["1"]["x"] == out[other]["x"] and out["1"]["r"] == out[other]["r"], other
+
+
+def test_vector_width_is_chosen_only_where_numba_leaves_it_open(monkeypatch):
+    from numba import config
+    from numba.core.codegen import get_host_cpu_features
+
+    from stabdae import _vector_width
+
+    monkeypatch.setattr(config, "CPU_FEATURES", None)
+    # this process has compiled: numba's features are fixed, nothing may change them
+    assert _vector_width.choose({}) is False and config.CPU_FEATURES is None
+    # a user's own features stand (here in a fresh process, where the choice is open)
+    host = get_host_cpu_features()
+    env = dict(os.environ, NUMBA_CPU_FEATURES=host)
+    env.pop("STABDAE_VECTOR_WIDTH", None)
+    proc = subprocess.run([sys.executable, "-c", "import numba, stabdae; "
+                           "print(stabdae._vector_width.PREFER_512, numba.config.CPU_FEATURES)"],
+                          capture_output=True, text=True, env=env, check=True)  # fmt: skip
+    assert proc.stdout.split() == ["False", host]
+
+
+def test_divergence_is_isolated():
+    """Members that blow up (singular S at q = 0, a residual above the threshold, a NaN
+    start) are flagged and frozen; the others give the same numbers as without them."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    good, _, _ = stabdae.sample_perturbations(model, 6, (1e-4, 1e-3), seed=1)
+    singular = np.array([0.0, 0.0, 0.1, 0.0])  # f_q = 0: S = F Fᵀ = 0
+    far = model.reference_state() * np.array([3.0, 3.0, 1.0, 1.0])  # |f| = 8 > threshold
+    nan = np.full(4, np.nan)
+    mixed = np.vstack([good[:2], singular, good[2:4], far, nan, good[4:]])
+    kw = dict(epsilon=1.0, divergence=5.0, save_dt=0.01)
+    a = stabdae.ensemble(model, law, "rk4", 1e-3, 0.5, x0=mixed, **kw)
+    b = stabdae.ensemble(model, law, "rk4", 1e-3, 0.5, x0=good, **kw)
+    keep = [0, 1, 3, 4, 7, 8]
+    for name in ("residual_norm", "x_final", "beta", "gamma", "bounded"):
+        np.testing.assert_array_equal(a[name].values[keep], b[name].values)
+    status = a.status.values
+    assert status[2] == stabdae.Status.SINGULAR_S
+    assert status[5] == stabdae.Status.DIVERGED and a.diverged_step.values[5] == 0
+    assert status[6] == stabdae.Status.NONFINITE_STATE
+    assert a.diverged.values[[2, 5, 6]].all() and not a.diverged.values[keep].any()
+    assert not a.bounded.values[[2, 5, 6]].any() and b.bounded.values.all()
+
+
+def test_dataset_schema_and_round_trip(tmp_path):
+    ds = baumgarte_ensemble("double_pendulum", "midpoint", 1.0, members=16)
+    assert_schema(ds)
+    assert ds.residual_norm.dtype == np.float32
+    for key in ("model", "law", "scheme", "tau", "seed", "stabdae_version", "created_at"):
+        assert key in ds.attrs, key
+    assert ds.attrs["residual_norm_dtype"] == "float32"
+    assert ds.attrs["fused_multiply_add"] == int(HOST_FMA)
+    path = write_netcdf(ds, tmp_path / "ens.nc")
+    with xr.open_dataset(path) as back:
+        xr.testing.assert_identical(back.load(), ds)
+        for name in ("residual_norm", "x0", "beta"):  # zlib-compressed, shuffled
+            enc = back[name].encoding
+            assert enc.get("zlib") is True and enc.get("shuffle") is True, (name, enc)
+
+
+def test_ensemble_errors():
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    with pytest.raises(ValueError, match=r"^ensemble: radius must be a positive number or a pair"):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, radius=(-1.0, 1.0))
+    with pytest.raises(ValueError, match=r"^ensemble: radius low = 1 exceeds high = 0.1"):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, radius=(1.0, 0.1))
+    with pytest.raises(ValueError, match=r"^ensemble: members must be a positive integer, got 0"):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=0)
+    with pytest.raises(
+        ValueError, match=r"^ensemble: x0 must have shape \(members, 2n\) = \(M, 4\)"
+    ):
+        stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, x0=np.zeros((3, 3)))
+
+
+def _scheme(spec):
+    if isinstance(spec, str):
+        return spec
+    with warnings.catch_warnings():  # σ = 0 and σ = 2 are first order, and say so
+        warnings.simplefilter("ignore", UserWarning)
+        return stabdae.two_stage(*spec)
+
+
+@pytest.mark.parametrize("spec", ["euler", "midpoint", "rk4", "dop853", (0.3, 0.0), (0.25, 2.0)])
+def test_every_tableau_pattern_equals_single_integrations(spec):
+    """The ensemble kernel is compiled per pattern of zero / one / other coefficients and
+    writes the stages out; its numbers are still those of ``integrate`` bit for bit
+    (σ = 0 has a zero weight, σ = 2 two general ones, DOP853 twelve stages and zeros
+    inside A and b; dopri5's pattern is covered below)."""
+    scheme = _scheme(spec)
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    ds = stabdae.ensemble(model, law, scheme, 2e-3, 0.2, members=3, seed=5, save_dt=0.02)
+    for j in range(3):
+        one = stabdae.integrate(model, ds.x0.values[j], law, scheme, 2e-3, 0.2, 0.02)
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+        np.testing.assert_array_equal(ds.residual_norm.values[j],
+                                      one.residual_norm.values.astype(np.float32))  # fmt: skip
+
+
+@pytest.mark.parametrize("spec", ["rk4", "dopri5"])
+def test_time_dependent_model_stage_times_equal_single_integrations(spec):
+    """On time-dependent constraints (the pendulum of prescribed length, the car axis) the
+    stage times t + c·τ matter: the ensemble kernel's generated step gives the numbers of
+    ``integrate`` bit for bit.  The stage times are formed alike for every pattern of
+    coefficients (the patterns themselves are covered on the pendulum above); RK4 repeats
+    a stage time, dopri5 has seven distinct ones and zeros inside A."""
+    scheme = _scheme(spec)
+    cases = [("pendulum_varying_length", stabdae.baumgarte(10.0, 1.0), 2e-3)]
+    if spec == "rk4":  # (one pattern on the car axis: each pattern is a compilation)
+        cases.append(("car_axis", stabdae.baumgarte(50.0, 1.0), 1e-3))
+    for name, law, tau in cases:
+        model = load_scene(name)
+        ds = stabdae.ensemble(model, law, scheme, tau, 0.1, members=3, seed=5,
+                              radius=(1e-6, 1e-4), save_dt=0.02)  # fmt: skip
+        assert (ds.status.values == 0).all()
+        for j in range(3):
+            one = stabdae.integrate(model, ds.x0.values[j], law, scheme, tau, 0.1, 0.02)
+            np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+            np.testing.assert_array_equal(ds.residual_norm.values[j],
+                                          one.residual_norm.values.astype(np.float32))  # fmt: skip
+
+
+def test_reference_residuals_are_those_of_integrate():
+    """Each member's decay is measured on its distance from the residual of the trajectory
+    from the reference state.  Its run (the ensemble kernel with that one member) gives
+    ``integrate``'s residual at every step bit for bit, sample and stage times included
+    (a time-dependent model: a residual at the wrong time differs at once)."""
+    from stabdae._ensemble import _reference_residuals
+    from stabdae._laws import bind_law
+
+    model = load_scene("pendulum_varying_length")
+    law = stabdae.baumgarte(10.0, 1.0)
+    p, tau, nsteps = model.param_vector(), 2e-3, 50
+    g = _reference_residuals(model, bind_law(law, model), stabdae.rk4(), p, model.t0, tau,
+                             nsteps)  # fmt: skip
+    one = stabdae.integrate(model, model.reference_state(p), law, "rk4", tau,
+                            model.t0 + nsteps * tau, tau)  # fmt: skip
+    assert g.shape == (nsteps + 1, model.n_residual) and np.abs(g[-1]).max() > 0
+    np.testing.assert_array_equal(g, one.residual.values)
+
+
+def test_members_stopped_mid_run_keep_their_last_good_state():
+    """Euler at τ = 0.25 with ω = 10 is unstable: every member grows until it stops, at a
+    step of its own, so the block loses its members one by one and ends with none running.
+    A member stopped at a stored sample (residual above the threshold) keeps that state;
+    one whose step overflowed keeps the state before that step.  Both equal ``integrate``
+    run up to that step, bit for bit."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    tau = 0.25
+    x0, _, _ = stabdae.sample_perturbations(model, 5, (1e-3, 1e-1), seed=3)
+    runs = {
+        stabdae.Status.DIVERGED: stabdae.ensemble(
+            model, law, "euler", tau, 250.0, x0=x0, save_dt=tau, epsilon=1.0, divergence=1e250
+        ),
+        stabdae.Status.NONFINITE_STATE: stabdae.ensemble(
+            model, law, "euler", tau, 250.0, x0=x0, save_dt=250.0, epsilon=1.0, divergence=1e300
+        ),
+    }
+    for status, ds in runs.items():
+        assert (ds.status.values == status).all(), status
+        steps = ds.diverged_step.values
+        assert len(set(steps.tolist())) > 1 and (steps > 0).all()
+        if status == stabdae.Status.NONFINITE_STATE:  # the block was rolled back
+            assert ((steps > CHECKPOINT) & (steps % CHECKPOINT > 1)).any(), steps
+        for j in range(5):
+            span = steps[j] * tau
+            one = stabdae.integrate(model, x0[j], law, "euler", tau, span, span)
+            np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
+            # the stored samples up to the stop are the trajectory's, NaN after it
+            every = round(float(ds.attrs["save_dt"]) / tau)
+            full = stabdae.integrate(model, x0[j], law, "euler", tau, span, tau)
+            ref = full.residual_norm.values[::every].astype(np.float32)
+            row = ds.residual_norm.values[j]
+            np.testing.assert_array_equal(row[: len(ref)], ref)
+            assert np.isnan(row[len(ref):]).all()
+
+
+def test_traces_and_states_are_optional_and_change_no_measurement():
+    """traces='none', a number, 'all', and states=False: the same β, classes and
+    summaries; the stored traces are those of the named members; the measurements are
+    stored in single precision, the summaries computed in double."""
+    model = load_scene("pendulum")
+    run = lambda tr, st=True: stabdae.ensemble(model, stabdae.baumgarte(10, 1), "midpoint",  # noqa: E731
+                                               1e-3, 1.0, members=40, seed=1, traces=tr,
+                                               states=st)  # fmt: skip
+    every, none, some, bare = run("all"), run("none"), run(7), run(7, False)
+    assert none.sizes["trace"] == 0 and every.sizes["trace"] == 40 and some.sizes["trace"] == 7
+    for ds in (none, some, bare):
+        np.testing.assert_array_equal(ds.beta.values, every.beta.values)
+        np.testing.assert_array_equal(ds.stability_class.values, every.stability_class.values)
+    np.testing.assert_array_equal(some.residual_norm.values,
+                                  every.residual_norm.sel(trace=some.trace).values)
+    assert "x0" not in bare and "x_final" not in bare and "x_final" in some
+    # the floor is the largest norm of the last fifth of the run: against the stored norms
+    # there (the kernel measures every s-th step, the samples are every 50th)
+    tail = every.residual_norm.sel(time=slice(0.8, None)).max("time").values
+    ratio = every.residual_floor.values / tail
+    assert np.all((ratio >= 1 / 1.5) & (ratio <= 1.5)), ratio
+    xr.testing.assert_identical(bare, some.drop_vars(["x0", "x_final"]).assign_attrs(bare.attrs))
+    for name in ("beta", "gamma", "beta_ratio", "fit_start"):
+        assert every[name].dtype == np.float32, name
+    for name in ("max_residual", "residual_floor", "overshoot", "alpha0", "alpha0_norm",
+                 "beta_median"):
+        assert every[name].dtype == np.float64, name
+    assert every.fit_points.dtype == np.int32 and every.diverged_step.dtype == np.int32
+    # the median of the double-precision rates, not of their single-precision copies
+    assert float(every.beta_median) != float(np.median(every.beta.values.astype(float)))
+    with pytest.raises(ValueError, match="ensemble: traces must be"):
+        run("some")
+    with pytest.raises(TypeError, match=r"ensemble: states must be True or False, got 'no'"):
+        run(7, "no")
+
+
+@njit
+def _mass_swing(t, q, p, out):
+    """SPD only while q0 > −1/2: the members below stop when their swing gets there."""
+    out[0, 0] = 1.0
+    out[0, 1] = 0.0
+    out[1, 0] = 0.0
+    out[1, 1] = q[0] + 0.5
+
+
+def test_members_stopped_by_a_status_keep_their_last_good_state():
+    """A step that fails with a status (mass not SPD) leaves finite numbers, which the
+    block's check after 32 steps or at a sample still sees: each member stops at its own
+    step, keeps the state before it and reports the status, as ``integrate`` does."""
+    from toy import unit_pendulum
+
+    model = unit_pendulum("swing_mass", mass=_mass_swing)
+    x0 = np.array([[0.0, -1.0, -v, 0.0] for v in (2.0, 2.5, 3.0, 3.5, 4.0)])
+    law = stabdae.baumgarte(10.0)
+    ds = stabdae.ensemble(model, law, "rk4", 1e-3, 1.0, x0=x0, save_dt=0.1)
+    steps = ds.diverged_step.values
+    assert (ds.status.values == stabdae.Status.MASS_NOT_SPD).all()
+    assert len(set(steps.tolist())) == 5 and (steps % CHECKPOINT > 1).any(), steps
+    for j in range(5):
+        with pytest.warns(stabdae.IntegrationWarning, match="not symmetric positive"):
+            one = stabdae.integrate(model, x0[j], law, "rk4", 1e-3, 1.0, 1e-3)
+        assert one.attrs["steps_completed"] == steps[j]
+        np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[steps[j]])

@@ -1,0 +1,295 @@
+"""What an ensemble measures per member: β against the discrete prediction, the
+one-step map's rate, the storage interval and the stride changing no rate, the
+stability classes, the intervals, the stability radius and the roundoff level."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import stabdae
+from conftest import baumgarte_ensemble, load_scene
+from stabdae.engine import decay
+
+
+@pytest.mark.parametrize("xi", [0.5, 0.7, 1.0, 2.0])
+@pytest.mark.parametrize(
+    "name, scheme",
+    [(name, scheme) for name in ("pendulum", "double_pendulum")
+     for scheme in ("euler", "midpoint", "heun", "rk4")]
+    # the generated spherical pendulum with one scheme (its other schemes, and a model of
+    # n = 60, in studies/check_member_rates.py: each scheme is a kernel to compile)
+    + [("spherical_pendulum", "midpoint")],
+)  # fmt: skip
+def test_beta_matches_discrete_prediction(name, scheme, xi):
+    """Median β within 2 % of −ln ρ(R(τÃ))/τ (5 % under-damped) and each member's β within
+    1 % of its linear prediction's (2 % at the largest perturbations): under-damped (an
+    oscillating residual), critically damped (repeated eigenvalue, Euler's R(τÃ) a Jordan
+    block) and over-damped."""
+    ds = baumgarte_ensemble(name, scheme, xi)
+    assert (ds.status == 0).all()
+    predicted = float(ds.beta_theory_discrete)
+    # an under-damped residual's fit window holds one or two of its periods here
+    assert abs(float(ds.beta_median) / predicted - 1) <= (0.02 if xi >= 1 else 0.05)
+    ratio = ds.beta_ratio.values
+    # measured over the linear prediction; the largest perturbations (‖α⁰‖ near 0.1, a
+    # tenth of the rods' length) leave the linear regime: Euler's quadratic terms move
+    # the double pendulum's rate there by up to 1.4 %
+    small = ds.alpha0_norm.values <= 0.05
+    assert np.mean(np.abs(ratio[small] - 1) < 0.01) >= 0.95
+    assert np.all(np.abs(ratio - 1) < 0.02)
+    if scheme == "euler" and xi == 1.0:  # here discrete and continuous rates differ by 5 %
+        assert abs(float(ds.beta_theory) / predicted - 1) > 0.04
+
+
+@pytest.mark.parametrize("scheme", ["midpoint", "rk4"])
+@pytest.mark.parametrize("xi", [1.05, 3.0])
+def test_beta_leaves_out_the_lead_of_the_transient(xi, scheme):
+    """Over-damped laws: a second mode (nearly as slow at ξ = 1.05, much faster at ξ = 3)
+    bends the start of the transient.  With the fit window after the first 30 % of its
+    decades the median β is within 1 % of −ln ρ(R(τÃ))/τ (measured: within 0.1 %); a fit
+    over the whole transient is 4–10 % off."""
+    ds = baumgarte_ensemble("pendulum", scheme, xi)
+    assert abs(float(ds.beta_median) / float(ds.beta_theory_discrete) - 1) <= 0.01
+
+
+def test_stability_radius_is_bracketed():
+    """Members at known radii 1e-5 … 2e-1 with ε = 1e-3: the three that start above ε are
+    not bounded (but stable: they decay), the two below it are; with every member stable
+    δ* is not bracketed (NaN, its low end the largest radius); with a divergence threshold
+    that stops the two largest members, δ* lies between 1e-2 and 1e-1."""
+    model = load_scene("pendulum")
+    radii = (1e-5, 1e-4, 1e-2, 2e-1, 1e-1)
+    x0 = np.concatenate([stabdae.sample_perturbations(model, 1, (r, r), seed=i)[0]
+                         for i, r in enumerate(radii)])  # fmt: skip
+    ds = stabdae.ensemble(model, stabdae.baumgarte(10.0, 1.0), "midpoint", 1e-3, 2.0, x0=x0,
+                          epsilon=1e-3)  # fmt: skip
+    np.testing.assert_allclose(ds.alpha0_norm.values, radii, rtol=1e-9)
+    assert ds.bounded.values.tolist() == [1, 1, 0, 0, 0]
+    assert ds.stable.values.tolist() == [1, 1, 1, 1, 1]
+    assert np.isnan(float(ds.stability_radius))
+    assert float(ds.stability_radius_low) == float(ds.alpha0_norm.values[3])
+    with pytest.warns(stabdae.IntegrationWarning):
+        cut = stabdae.ensemble(model, stabdae.baumgarte(10.0, 1.0), "midpoint", 1e-3, 2.0,
+                               x0=x0, epsilon=1e-3, divergence=0.05)  # fmt: skip
+    a = cut.alpha0_norm.values
+    # two members stop: δ*'s upper end is the smaller of their radii
+    assert cut.stable.values.tolist() == [1, 1, 1, 0, 0]
+    assert float(cut.stability_radius_low) == a[2] and float(cut.stability_radius_high) == a[4]
+    assert a[2] < float(cut.stability_radius) < a[4]
+
+
+def test_bounded_needs_the_residual_to_have_decayed():
+    """An unstable law (f̈ = 5 f) over 1 s: a member that starts with ḟ = 1e-6 (and f = 0)
+    grows as ḟ₀ cosh(√5 t), to about 4.7e-6, stays far below ε = 1 and is still not
+    bounded, since it did not decay; members on the manifold (their residual stays at
+    roundoff) are bounded."""
+    model = load_scene("pendulum")
+    x_ref = model.reference_state()
+    q = x_ref[:2]
+    off = x_ref.copy()
+    off[2:] += 1e-6 / (2 * q @ q) * q  # ḟ = 2 q·v grows by 1e-6; f unchanged
+    x0 = np.concatenate([np.tile(x_ref, (7, 1)), off[None, :]])
+    ds = stabdae.ensemble(model, stabdae.matrix([[5.0, 0.0]]), "rk4", 1e-3, 1.0, x0=x0,
+                          epsilon=1.0)  # fmt: skip
+    assert (ds.status.values == 0).all() and float(ds.max_residual[7]) < 1e-4
+    assert float(ds.residual_norm[7, -1]) > 3 * float(ds.alpha0_norm[7])
+    assert ds.bounded.values.tolist() == [1] * 7 + [0]
+
+
+def test_beta_does_not_depend_on_the_storage_interval():
+    """Critically damped ω = 10, midpoint, τ = 1e-3: every member's β is the same number
+    for save_dt = 0.025 (the default), 0.01 and 0.1 (it is measured at every step), the
+    median within 1 % of ω = 10, and measured over predicted within 1 % for every member
+    (the residual's floor, 7e-6 here, lies inside the sampled radii: the rate is read on
+    the distance from the reference trajectory)."""
+    model = load_scene("pendulum")
+    run = lambda dt: stabdae.ensemble(model, stabdae.baumgarte(10, 1), "midpoint", 1e-3,  # noqa: E731
+                                      5.0, members=128, radius=(1e-6, 1e-2), seed=1,
+                                      save_dt=dt)  # fmt: skip
+    ds = run(None)
+    for dt in (0.01, 0.1):
+        np.testing.assert_array_equal(run(dt).beta.values, ds.beta.values)
+    assert int(ds.members_with_beta) == 128
+    assert abs(float(ds.beta_median) / 10.0 - 1) < 0.01
+    assert float(ds.beta_median_low) <= float(ds.beta_median) <= float(ds.beta_median_high)
+    assert np.all(np.abs(ds.beta_ratio.values - 1) < 0.01)
+    assert float(ds.residual_floor.median()) > 1e-6  # the floor is inside the radii
+
+
+def test_stability_classes():
+    """ω = 300 critically damped at τ = 1e-3 (ρ = 0.745): members overshoot ε by the
+    law's own transient, yet every one is stable; the unstable law f̈ = 5f over 3 s: no
+    member stable (over 1 s, a few started close to the decaying direction are still
+    decaying at the end: e^{−√5 t} has not yet given way to e^{√5 t});
+    radii 1e-12 … 1e-10: none diverges; ε below the floor: floor above ε; τ past the
+    spectral limit: diverged."""
+    from stabdae._measures import CLASSES
+
+    model = load_scene("pendulum")
+    kw = dict(members=64, seed=2, radius=(1e-6, 1e-2))
+    ens = lambda law, tau, t_end, **k: stabdae.ensemble(model, law, "midpoint", tau,  # noqa: E731
+                                                        t_end, **{**kw, **k})  # fmt: skip
+    fast = ens(stabdae.baumgarte(300, 1), 1e-3, 1.0)
+    classes = [CLASSES[c] for c in fast.stability_class.values]
+    assert float(fast.fraction_stable) == 1.0 and "overshoot" in classes
+    assert float(fast.overshoot.max()) <= 2 * float(fast.overshoot_theory)
+    with warnings.catch_warnings():  # members that grow past the divergence threshold
+        warnings.simplefilter("ignore", stabdae.IntegrationWarning)
+        unstable = ens(stabdae.matrix([[5.0, 0.0]]), 1e-3, 3.0, members=256)
+        short = ens(stabdae.matrix([[5.0, 0.0]]), 1e-3, 1.0, members=256)
+    assert float(unstable.fraction_stable) == 0.0
+    assert float(unstable.fraction_stable_high) < 0.02
+    assert float(short.fraction_stable) <= 0.08
+    tiny = ens(stabdae.baumgarte(10, 1), 1e-3, 2.0, radius=(1e-12, 1e-10), epsilon=1e-3)
+    assert int(tiny.members_diverged) == 0 and float(tiny.fraction_stable) == 1.0
+    # they start below the midpoint rule's floor (about 7e-6 here): they never decayed
+    assert (tiny.stability_class.values == CLASSES.index("at_floor")).all()
+    low = ens(stabdae.baumgarte(10, 1), 1e-3, 2.0, epsilon=1e-7)
+    assert CLASSES.index("floor_above_epsilon") in low.stability_class.values
+    with pytest.warns(stabdae.IntegrationWarning):
+        bad = ens(stabdae.baumgarte(10, 1), 0.25, 20.0)
+    assert (bad.stability_class.values == CLASSES.index("diverged")).all()
+    assert float(bad.fraction_stable) == 0.0 and np.isnan(float(bad.stability_radius))
+
+
+def test_wilson_and_median_intervals():
+    """Wilson's 95 % interval at its textbook values (0 of 10: [0, 0.2775]; 5 of 10:
+    [0.2366, 0.7634]); the median's interval at its ranks, covering the true median of
+    normal samples about 95 % of the time."""
+    from stabdae._measures import median_interval, wilson
+
+    np.testing.assert_allclose(wilson(0, 10), (0.0, 0.2775), atol=5e-5)
+    np.testing.assert_allclose(wilson(5, 10), (0.2366, 0.7634), atol=5e-5)
+    x = np.random.default_rng(0).standard_normal(10_000)
+    med, lo, hi = median_interval(x)
+    v = np.sort(x)  # ranks n/2 ∓ 1.96 √n / 2 = 5000 ∓ 98
+    assert (med, lo, hi) == (np.median(x), v[4902], v[5098])
+    # over many samples the interval covers the true median (0) about 95 % of the time
+    rng = np.random.default_rng(1)
+    cover = [lo <= 0 <= hi for lo, hi in (median_interval(rng.standard_normal(400))[1:]
+                                          for _ in range(2000))]  # fmt: skip
+    assert 0.93 < np.mean(cover) < 0.97
+
+
+@pytest.mark.parametrize("scheme", ["euler", "midpoint", "rk4"])
+@pytest.mark.parametrize("xi", [0.3, 1.0, 3.0])
+def test_one_step_map_gives_the_discrete_rate_of_a_short_transient(scheme, xi):
+    """On the affine system the residual follows ``g_{k+1} = R(τÃ) g_k`` exactly.  Over a
+    short run (six time constants of the slowest mode: two decades or less, with the
+    polynomial prefactor of a critically damped law, the beat of an under-damped one or
+    the fast mode of an over-damped one) every member's β is ``−ln ρ(R)/τ`` to 1e-4: the
+    one-step map fitted to its pairs is R (to roundoff, which moves a Jordan block's
+    eigenvalue by its square root).  (A fit of the norm's envelope over such a
+    window is off by up to half.)"""
+    from affine import model as affine
+
+    slowest = xi if xi < 1 else xi - math.sqrt(xi * xi - 1)  # ω = 1
+    law = stabdae.matrix([[-1.0, -2 * xi, 0.0], [0.0, 0.0, -5.0]])
+    ds = stabdae.ensemble(affine, law, scheme, 0.01, round(6 / slowest, 2), members=32,
+                          radius=(1e-6, 1e-3), seed=2, traces="none")  # fmt: skip
+    predicted = float(ds.beta_theory_discrete)
+    assert abs(predicted / slowest - 1) < 0.05
+    assert int(ds.members_with_beta) == 32
+    np.testing.assert_allclose(ds.beta.values, predicted, rtol=1e-4)
+    np.testing.assert_allclose(ds.beta_ratio.values, 1.0, rtol=1e-4)
+    assert set(ds.fit_kind.values.tolist()) == {decay.K_MAP}
+
+
+def test_measurement_stride_changes_no_rate(monkeypatch):
+    """The fixed-step kernel measures every s-th step, s from the law's one-step map (ω = 10,
+    ξ = 1, midpoint, τ = 1e-3: |ln λ| = 0.01 per step, s = 20; a law thirty times faster
+    gets s = 1; not constant: 1).  β from pairs a stride apart is that of every step to
+    1e-5 (the map fitted to them is R^s, whose radius is ρ(R)^s), the floor and the
+    largest norm within the stride's resolution (a change of 0.2 in ln: a maximum read at
+    most 0.2²/8 = 0.5 % low), γ within 2 %."""
+    from stabdae import _ensemble
+    from stabdae._schemes import as_scheme
+    from stabdae.theory import step_matrix
+
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10, 1)
+    A = law.A_tilde(model)
+    mid = as_scheme("midpoint")
+    assert _ensemble.measure_stride(step_matrix(A, mid, 1e-3)) == 20
+    assert _ensemble.measure_stride(step_matrix(30 * A, mid, 1e-3)) == 1
+    assert _ensemble.measure_stride(step_matrix(A, mid, 1e-5)) == _ensemble.MAX_STRIDE
+    assert _ensemble.measure_stride(np.zeros((0, 0))) == 1
+
+    run = lambda: stabdae.ensemble(model, law, "midpoint", 1e-3, 3.0, members=64,  # noqa: E731
+                                   radius=(1e-6, 1e-2), seed=5, traces="none")  # fmt: skip
+    strided = run()
+    monkeypatch.setattr(_ensemble, "measure_stride", lambda R: 1)
+    every = run()
+    assert strided.attrs["measure_every"] == 20 and every.attrs["measure_every"] == 1
+    assert int(every.members_with_beta) == int(strided.members_with_beta) == 64
+    np.testing.assert_allclose(strided.beta.values, every.beta.values, rtol=1e-5)
+    # γ: the largest ‖g‖e^{βt} on the transient, for a Jordan block |c0 + c1 t| at the
+    # transient's end, which a stride moves by up to one stride (2 % of the window here)
+    np.testing.assert_allclose(strided.gamma.values, every.gamma.values, rtol=0.02)
+    for name in ("residual_floor", "max_residual"):
+        np.testing.assert_allclose(strided[name].values, every[name].values, rtol=0.005,
+                                   err_msg=name)  # fmt: skip
+    for name in ("residual_floor", "max_residual"):  # maxima over a subset of the states
+        assert (strided[name].values <= every[name].values).all(), name
+
+
+def test_map_window_of_a_member_still_decaying_ends_at_the_run_end():
+    """A member whose residual still falls when the run ends (ω = 10 over 2 s: no floor
+    yet) has the whole run as its map's window: ``fit_end`` is the final time, whose
+    state is on the ladder though the stride does not measure it (s = 20 ends at step
+    1980), and γ covers it."""
+    model = load_scene("pendulum")
+    ds = stabdae.ensemble(model, stabdae.baumgarte(10, 1), "midpoint", 1e-3, 2.0,
+                          members=256, radius=(1e-6, 1e-2), seed=5, traces="none")  # fmt: skip
+    still = ds.floor_reached.values == 0
+    assert ds.attrs["measure_every"] == 20 and still.sum() > 200
+    assert set(ds.fit_kind.values[still].tolist()) == {decay.K_MAP}
+    np.testing.assert_array_equal(ds.fit_end.values[still], 2.0)
+
+
+def test_members_whose_floor_rises_keep_the_map_rate():
+    """Under-damped double pendulum (ω = 20, ξ = 0.75, midpoint, τ = 2/700, 4 s, radii
+    1e-7 … 1e-3, as a point of the shipped τ × ξ study): most members start near the floor,
+    whose largest norms rise over the last fifths with the pendulum's swing.  They are
+    not growing (the envelope finds them decaying), so every member's β comes from the
+    one-step map and the median is −ln ρ/τ to 1e-4.  (Skipping the map for every member
+    whose largest norms rise left 236 of 256 to the envelope fit: median 12.9 for 15.0.)"""
+    model = load_scene("double_pendulum")
+    ds = stabdae.ensemble(model, stabdae.baumgarte(20.0, 0.75), "midpoint", 2 / 700, 4.0,
+                          members=256, radius=(1e-7, 1e-3), seed=2, traces="none",
+                          epsilon=1.0)  # fmt: skip
+    assert (ds.fit_kind.values == decay.K_MAP).all()
+    assert abs(float(ds.beta_median) / float(ds.beta_theory_discrete) - 1) < 1e-4
+
+
+def test_roundoff_level_of_the_pendulum_is_its_closed_form():
+    """The residual's roundoff level at a state is u · max_c Σ_i |∂g_c/∂x_i · x_i|; for the
+    pendulum's f = x² + y² − l², ḟ = 2(x ẋ + y ẏ) the sums are 2(x² + y²) and
+    4(|x ẋ| + |y ẏ|) (central differences are exact on quadratics up to rounding), and the
+    level of several states is the median of theirs; all states are differenced in one
+    call."""
+    from stabdae import _ensemble, _measures
+
+    model = load_scene("pendulum")
+    p = model.param_vector(None)
+    X = np.random.default_rng(3).normal(size=(5, 4))
+    calls = []
+
+    def rows(Y, at):
+        calls.append(Y.shape[0])
+        return _ensemble._residual_rows(model, np.ascontiguousarray(Y), p, at)
+
+    u = np.finfo(float).eps / 2.0
+    x, y, vx, vy = X.T
+    each = np.maximum(2.0 * (x * x + y * y), 4.0 * (np.abs(x * vx) + np.abs(y * vy)))
+    got = _measures.roundoff_level(rows, X, 0.7)
+    assert got == pytest.approx(u * np.median(each), rel=1e-6)
+    assert calls == [5 * 9, 5]  # the differences of every state, then the time shifts
+    for i in range(5):
+        assert _measures.roundoff_level(rows, X[i : i + 1], 0.7) == pytest.approx(
+            u * each[i], rel=1e-6)
+    assert _measures.roundoff_level(rows, X[:0], 0.7) == 0.0

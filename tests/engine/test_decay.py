@@ -1,0 +1,318 @@
+"""The in-kernel decay measurement's pieces (``stabdae.engine.decay``): the ladder and
+its envelope points, the fits, the one-step map's bins and γ, the logarithm, and
+the estimator over stored traces against NumPy."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numba import njit
+
+from stabdae.engine import decay
+
+
+def test_measures_of_stored_traces_match_numpy():
+    """Initial, largest and final norm of traces with stops (inf, NaN) are NumPy's over
+    the leading finite samples; a stopped trace gets no β and the reason "stopped"."""
+    from stabdae.engine import decay
+
+    norms = np.random.default_rng(0).random((40, 30))
+    norms[3, 10:] = np.nan
+    norms[5, 7], norms[5, 8:] = np.inf, np.nan
+    meas = decay.measure_traces(norms, np.linspace(0.0, 1.0, 30))
+    for j in range(40):
+        row = norms[j]
+        n = int(np.argmin(np.isfinite(row))) if not np.isfinite(row).all() else row.size
+        assert meas[j, decay.C_INITIAL] == row[0]
+        assert meas[j, decay.C_LARGEST] == row[:n].max()
+        assert meas[j, decay.C_FINAL] == row[n - 1]
+    assert meas[3, decay.C_REASON] == decay.R_STOPPED and np.isnan(meas[3, decay.C_BETA])
+
+
+def test_ladder_records_are_the_right_envelope():
+    """The ladder's points are, level by level, the last sample on that level, and exactly
+    those of them that no later sample exceeds (the right envelope), in time order."""
+    import struct
+
+    from stabdae.engine import decay
+
+    rng = np.random.default_rng(4)
+    v = np.exp(-np.linspace(0, 12, 700) + 2.0 * rng.standard_normal(700))
+    lt, lv, base = decay.ladders(1)
+    rt, ry = np.empty(decay.NBINS), np.empty(decay.NBINS)
+    decay.ladder_clear(lt, 0)
+    base[0] = decay.ladder_base(v[0])
+    bits = lambda x: struct.unpack("<q", struct.pack("<d", x))[0]  # noqa: E731
+    level = [min(max((bits(x) >> 49) - base[0], 0), decay.NBINS - 1) for x in v]
+    for i, x in enumerate(v):
+        lt[0, level[i]], lv[0, level[i]] = float(i), x
+    n = decay.records(lt, lv, 0, rt, ry)
+    last_on_level = {lev: i for i, lev in enumerate(level)}
+    expect = sorted(i for i in last_on_level.values() if i == v.size - 1 or v[i] > v[i + 1:].max())
+    assert rt[:n].tolist() == [float(i) for i in expect]
+    np.testing.assert_array_equal(ry[:n], np.log(v[expect]))
+
+
+def test_map_gamma_is_the_largest_product_on_the_envelope():
+    """γ of a member measured by its one-step map, taken over every visited level in one
+    branch-free pass, is ``max ‖g‖e^{βt}`` over the right envelope's points on the levels
+    from the cut up (:func:`decay.records`, the definition), and the latest time is that
+    of the envelope: on a noisy decay with rises (points that are not on the envelope) and
+    a zero norm (none), at rates below, at and above the decay's; from a cut below the
+    ladder (none of it left out), and over fewer levels than the pass takes at a time."""
+    import struct
+
+    rng = np.random.default_rng(11)
+    t = np.linspace(0.0, 6.0, 900)
+    v = np.exp(-2.0 * t + 0.7 * rng.standard_normal(t.size))
+    v[450] = 0.0
+    lt, lv, base = decay.ladders(1)
+    decay.ladder_clear(lt, 0)
+    base[0] = decay.ladder_base(v[0])
+    bits = lambda x: struct.unpack("<q", struct.pack("<d", x))[0]  # noqa: E731
+    level = [min(max((bits(x) >> 49) - base[0], 0), decay.NBINS - 1) for x in v]
+    for i, x in enumerate(v):
+        lt[0, level[i]], lv[0, level[i]] = t[i], x
+    top = max(level)
+    u = np.empty(decay.NBINS)
+    for lo in (-3, 0, min(level) + 40, top - 60, top - 5, top):  # runs of 8 levels, a tail
+        above = {lev: i for i, lev in enumerate(level) if lev >= lo}  # last visit per level
+        later_max = np.maximum.accumulate(v[::-1])[::-1]  # the largest from each sample on
+        env = [i for i in above.values()
+               if v[i] > 0 and (i == v.size - 1 or later_max[i + 1] < v[i])]  # fmt: skip
+        for beta in (0.5, 2.0, 7.0):
+            gamma, t_end = decay.onestep._map_gamma(lt, lv, 0, lo, top, beta, u)
+            expect = max(v[i] * math.exp(beta * t[i]) for i in env)
+            assert gamma == pytest.approx(expect, rel=1e-14), (lo, beta)
+            assert t_end == max(t[i] for i in above.values())
+
+
+def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
+    """The one-step map's sums of bin ``b`` are those of the pairs whose first state came
+    before the member's level first fell below bin ``b`` (the transient above it; their
+    number exactly, since the sums of the last pairs are below the others' roundoff), also
+    when the residual comes back above it (a floor's jitter): on a block of two members,
+    one decaying with rises and one that jumps several bins at once, against the sums
+    taken pair by pair."""
+    B, ng = 2, 2
+
+    @njit
+    def run(G):  # G[k, l, j]: the residual of member j at measured state k
+        S = decay.map_buffers(B, ng, 1)
+        lt, lv, base = decay.ladders(B)
+        Dv, P, A = np.zeros((ng, B)), np.zeros((ng, B)), np.zeros((10, B))
+        gn, dn, gr = np.zeros(B), np.zeros(B), np.zeros(ng)
+        low, nlev = np.zeros(B, np.int64), np.zeros(B, np.int64)
+        wmax, dmax = np.full(B, -np.inf), np.full(B, -np.inf)
+        active = np.ones(B, np.bool_)
+        for k in range(G.shape[0]):
+            Dv[:, :] = G[k]
+            decay.difference_norms(Dv, gr, gn, dn)
+            if k == 0:
+                for j in range(B):
+                    base[j] = decay.ladder_base(dn[j])
+                    low[j] = decay.ladder_level(dn[j], base[j]) >> decay.MAP_SHIFT
+            decay.pairs_pooled(Dv, P, A, 1.0 if k > 0 else 0.0, 1)
+            changed = decay.block_levels(gn, dn, base, low, nlev, wmax, dmax)
+            if changed != 0:
+                decay.bin_flush(S, A, nlev, low, changed, 1, 0)
+            for j in range(B):
+                lt[j, nlev[j]] = float(k)
+                lv[j, nlev[j]] = dn[j]
+        decay.end_flush(S, A, low, active, 1, 0)
+        return S, base
+
+    rng = np.random.default_rng(2)
+    K = 400
+    decay_ = np.exp(-np.linspace(0.0, 40.0, K))
+    decay_[300:] = decay_[299] * np.exp(3.0 * rng.standard_normal(100))  # a jittering floor
+    jump = np.exp(-np.linspace(0.0, 30.0, K))
+    jump[200:] *= 1e-6  # six decades at once: several bins crossed by one state
+    phase = rng.uniform(0, 2 * np.pi, (K, 1))
+    G = np.empty((K, ng, B))
+    for j, amp in enumerate((decay_, jump)):
+        G[:, 0, j] = amp * np.cos(phase[:, 0] + j)
+        G[:, 1, j] = amp * np.sin(phase[:, 0] + j)
+    S, base = run(G)
+    bits = lambda x: np.frombuffer(np.float64(x).tobytes(), np.int64)[0]  # noqa: E731
+    for j in range(B):
+        norm = np.abs(G[:, :, j]).max(axis=1)
+        level = np.array([min(max((bits(x) >> 49) - base[j], 0), decay.NBINS - 1) for x in norm])
+        bins = level >> decay.MAP_SHIFT
+        crossed = 0
+        for b in range(decay.MAP_BINS):
+            below = np.nonzero(bins < b)[0]
+            first_below = below[0] if below.size else K
+            if b <= bins[0]:
+                crossed += first_below < K
+            # pairs (g_k, g_k+1) with k < first_below (the last one ends below the bin)
+            n = min(first_below, K - 1)
+            p, q = G[:n, :, j], G[1:n + 1, :, j]
+            if first_below == 0 or b > bins[0]:  # the member started below bin b: none
+                p, q = p[:0], q[:0]
+            expect = [p[:, 0] @ p[:, 0], p[:, 0] @ p[:, 1], p[:, 0] @ p[:, 1], p[:, 1] @ p[:, 1],
+                      q[:, 0] @ p[:, 0], q[:, 0] @ p[:, 1], q[:, 1] @ p[:, 0], q[:, 1] @ p[:, 1],
+                      0.0, 0.0, float(len(p))]  # fmt: skip
+            np.testing.assert_allclose(S[j, b], expect, rtol=1e-12, atol=0,
+                                       err_msg=f"member {j}, bin {b}")  # fmt: skip
+        assert crossed >= 8  # the test crosses bins, several at once for member 1
+
+
+@pytest.mark.parametrize("c0", [1.0, 0.1, -0.3])
+def test_fitted_rate_of_exact_decays(c0):
+    """β of exact traces ``|c0 + c1 t| e^{−βt}`` (a repeated eigenvalue's prefactor, its
+    zero crossing before the window for c0 < 0), ``e^{−βt}`` and ``e^{−βt}`` times an
+    oscillation, each on a floor of seeded noise: the true β within 1 %; γ the smallest
+    prefactor of ``e^{−βt}`` over the transient."""
+    from stabdae.engine import decay
+
+    beta, c1 = 10.0, 10.0
+    t = np.arange(4001) * 0.001  # the floor from t ≈ 2: the last fifth lies on it
+    rng = np.random.default_rng(2)
+    floor = 1e-9 * (1.0 + 0.5 * rng.random((3, t.size)))
+    traces = np.stack([
+        np.abs(c0 + c1 * t) * np.exp(-beta * t),
+        np.exp(-beta * t),
+        np.exp(-beta * t) * (1.2 + np.cos(15.0 * t)),
+    ]) + floor  # fmt: skip
+    meas = decay.measure_traces(traces, t)
+    got, gamma = meas[:, decay.C_BETA], meas[:, decay.C_GAMMA]
+    np.testing.assert_allclose(got, beta, rtol=0.01)
+    assert meas[2, decay.C_KIND] == decay.K_OSCILLATING
+    assert np.all(meas[:, decay.C_FLOOR] < 1.5e-9) and np.all(meas[:, decay.C_FLOOR] > 1e-9)
+    for j in range(3):  # γ e^{−βt} bounds the trace where it lies above 1000 × its floor
+        above = traces[j] > 1000 * meas[j, decay.C_FLOOR]
+        assert np.all(traces[j, above] <= gamma[j] * np.exp(-got[j] * t[above]) * 1.2)
+        assert np.any(traces[j, above] >= gamma[j] * np.exp(-got[j] * t[above]) / 1.2)
+
+
+@pytest.mark.parametrize("c0", [1.0, 0.1, -0.3])
+def test_refined_shift_gives_the_repeated_eigenvalue_rate(c0):
+    """On ``|c0 + c1 t| e^{−βt}`` with a floor at 1e-13, the ``ν log(t + s)`` fit with its
+    shift refined (Brent's method) recovers β to 0.2 %."""
+    from stabdae.engine import decay
+
+    t = np.arange(4001) * 0.001
+    floor = 1e-13 * (1.0 + 0.5 * np.random.default_rng(2).random(t.size))
+    trace = np.abs(c0 + 10.0 * t) * np.exp(-10.0 * t) + floor
+    meas = decay.measure_traces(trace[None, :], t)
+    assert meas[0, decay.C_KIND] == decay.K_POLYNOMIAL
+    assert abs(meas[0, decay.C_BETA] / 10.0 - 1) < 0.002
+
+
+def test_log_normal_is_the_library_logarithm_to_an_ulp():
+    """The branch-free logarithm the fits use (so that their loops vectorize) agrees with
+    the C library's to one unit in the last place over the whole normal range, and is
+    exact at 1."""
+    from numba import njit
+
+    from stabdae.engine import decay
+
+    @njit
+    def logs(x, out):
+        for i in range(x.shape[0]):
+            out[i] = decay.log_normal(x[i])
+
+    rng = np.random.default_rng(7)
+    x = np.concatenate([np.exp(rng.uniform(-708.0, 709.0, 200_000)),
+                        rng.uniform(0.5, 2.0, 200_000), 1.0 + rng.uniform(-1e-6, 1e-6, 10_000),
+                        [1.0, 2.0, 0.5, np.sqrt(0.5), np.sqrt(2.0), 2.2250738585072014e-308,
+                         1.7976931348623157e308]])  # fmt: skip
+    got = np.empty_like(x)
+    logs(x, got)
+    ref = np.log(x)
+    assert (got[x == 1.0] == 0.0).all()
+    nz = ref != 0.0
+    assert (np.abs(got - ref)[nz] <= np.spacing(np.abs(ref[nz]))).all()
+
+
+@pytest.mark.parametrize("shift", [0.05, 2.0])
+def test_log_prefactor_fit_recovers_an_exact_model(shift):
+    """``log ‖g‖ = c − βt + ν log(t + s)`` sampled without noise: the fit at that shift
+    returns its β to 1e-9 and a zero sum of squares."""
+    from stabdae.engine import decay
+
+    t = np.linspace(0.3, 1.5, 40)
+    y = 0.7 - 9.5 * t + 1.0 * np.log(t + shift)
+    rt, ry, a, b, lg = decay.scratch()
+    rt[:40], ry[:40] = t, y
+    beta, sse = decay.fit._fit_with_log(rt, ry, 0, 40, shift, a, b, lg,
+                                    decay.fit._shift_free_sums(rt, ry, 0, 40))
+    assert abs(beta - 9.5) < 1e-9 and sse < 1e-20
+
+
+@pytest.mark.parametrize("hint", [2.0, 2.3, 1e-3, 40.0, math.nan])
+def test_log_prefactor_search_from_a_hint_finds_the_grids_minimum(hint):
+    """The prediction's shift search starts at the measured member's shift: from a hint
+    near the true shift (2.0) it finds the exact model's β; from a hint far off (the
+    minimum on its bracket's edge) it falls back to the whole grid, as with no hint."""
+    from stabdae.engine import decay
+
+    t = np.linspace(0.3, 1.5, 40)
+    y = 0.7 - 9.5 * t + 1.0 * np.log(t + 2.0)
+    rt, ry, a, b, lg = decay.scratch()
+    rt[:40], ry[:40] = t, y
+    beta, sse, shift = decay.fit._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg, hint)
+    grid = decay.fit._fit_polynomial(rt, ry, 0, 40, 0.03, a, b, lg)
+    assert abs(beta - 9.5) < 1e-6 and abs(shift - 2.0) < 1e-3
+    assert abs(beta - grid[0]) < 1e-6
+
+
+def test_envelope_logarithms_are_the_librarys():
+    """The envelope's log norms (a vectorized logarithm over the row): within an ulp of
+    numpy's on normal norms; a row with a zero norm (−inf) or one below the normal floats
+    takes the library's log for every point."""
+    from stabdae.engine import decay
+
+    lt, lv, _ = decay.ladders(3)
+    rt, ry = np.empty(decay.NBINS), np.empty(decay.NBINS)
+    k = np.arange(40)
+    for j, last in enumerate([None, 0.0, 1e-310]):
+        v = np.geomspace(1e3, 1e-200, 40)  # a decay: level 139 - k visited last at time k
+        if last is not None:
+            v[-1] = last
+        lt[j, :] = -1.0
+        lt[j, 139 - k] = k
+        lv[j, 139 - k] = v
+        n = decay.records(lt, lv, j, rt, ry)
+        assert n == 40 and (rt[:n] == k).all()
+        with np.errstate(divide="ignore"):
+            ref = np.log(v)
+        if last is None:
+            assert (np.abs(ry[:n] - ref) <= np.spacing(np.abs(ref))).all()
+        else:
+            assert (ry[:n] == ref).all()
+            assert ry[n - 1] == (-np.inf if last == 0.0 else math.log(1e-310))
+
+
+def test_log_prefactor_fit_outside_the_normal_range_is_least_squares():
+    """A shift that puts t + s below the normal floats (t from 0, s = 1e-310) takes the
+    library's logarithm: the fit is then numpy's least squares on the same columns."""
+    from stabdae.engine import decay
+
+    t = np.linspace(0.0, 1.0, 30)
+    y = 0.3 - 4.0 * t + 0.01 * np.sin(7.0 * t)
+    rt, ry, a, b, lg = decay.scratch()
+    rt[:30], ry[:30] = t, y
+    beta, sse = decay.fit._fit_with_log(rt, ry, 0, 30, 1e-310, a, b, lg,
+                                    decay.fit._shift_free_sums(rt, ry, 0, 30))
+    X = np.column_stack([np.ones(30), -t, np.log(t + 1e-310)])
+    coef, res = np.linalg.lstsq(X, y, rcond=None)[:2]
+    assert abs(beta - coef[1]) < 1e-9 * abs(coef[1])
+    assert abs(sse - res[0]) < 1e-6 * res[0]
+
+
+def test_no_transient_or_growth_gives_no_rate_and_says_why():
+    """A trace that sits on its floor, and one that grows, get β = NaN with their
+    reasons, never a fitted number."""
+    from stabdae.engine import decay
+
+    t = np.arange(2001) * 1e-3
+    flat = 1e-6 * (1.0 + 0.5 * np.random.default_rng(3).random(t.size))
+    growing = 1e-6 * np.exp(3.0 * t)
+    meas = decay.measure_traces(np.stack([flat, growing]), t)
+    assert np.isnan(meas[:, decay.C_BETA]).all()
+    assert meas[0, decay.C_REASON] == decay.R_NO_TRANSIENT
+    assert meas[1, decay.C_REASON] == decay.R_NOT_DECAYING
