@@ -5,7 +5,7 @@ the initial states (:func:`sample_perturbations`, the compiled sampler of
 :mod:`.engine.sampler`), runs the block-lockstep kernel (:mod:`.engine.ensemble.block`) or,
 with ``rtol``, the per-member adaptive kernel (:mod:`.engine.ensemble.lanes`) over chunks of
 members on threads, each chunk's traces fitted (:mod:`.engine.decay`) by the thread that
-integrated them, and builds the dataset (:mod:`._schema`) beside the theorems'
+integrated them, and builds the dataset (:mod:`._ensemble_dataset`) beside the theorems'
 predictions (:mod:`.theory`).
 """
 
@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
-from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -23,10 +21,8 @@ import xarray as xr
 from . import _measures, theory
 from . import _validate as check
 from ._codes import Status
-from ._integrate import IntegrationWarning
-from ._laws import Theorem5
+from ._ensemble_dataset import _ensemble_dataset, _warn_stopped
 from ._model import Model
-from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_variable, variable
 from .engine import decay
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
 from .engine.ensemble.lanes import LANES, adaptive_block_for
@@ -516,22 +512,6 @@ def _run_adaptive(model, bound, pair, lanes, x0, alpha0, status, p, t0, save_tim
     return out
 
 
-def _warn_stopped(model, status) -> None:
-    """One warning for the members that stopped, counted by reason (as :func:`integrate`
-    warns for one trajectory)."""
-    stopped = Counter(int(s) for s in status[status != 0])
-    if not stopped:
-        return
-    reasons = ", ".join(f"{n} {Status(s).short}" for s, n in sorted(stopped.items()))
-    total = sum(stopped.values())
-    warnings.warn(
-        f"ensemble({model.name}): {total} of {status.shape[0]} members stopped: {reasons}; "
-        "their samples up to the stop are kept (see the status variable)",
-        IntegrationWarning,
-        stacklevel=3,
-    )
-
-
 #: members whose final states set the roundoff level the growth test compares with
 ROUNDOFF_SAMPLE = 16
 
@@ -551,103 +531,3 @@ def _roundoff(model, x_final, status, p, t, gain, threads, sampled=False):
         lambda X, at: _residual_rows(model, np.ascontiguousarray(X), p, at, threads, sampled),
         x_final[pick], t)  # fmt: skip
     return level * (gain if math.isfinite(gain) else 1.0)
-
-
-def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
-                      x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
-                      extra=None, roundoff=0.0, overshoot_theory=math.nan):  # fmt: skip
-    C = decay
-    meas[status != 0, C.C_BETA_PRED] = np.nan  # (not placed: measured on nothing)
-    for c in (C.C_BETA, C.C_GAMMA):
-        meas[status != 0, c] = np.nan
-    meas[(status != 0) & (meas[:, C.C_REASON] == C.R_FITTED), C.C_REASON] = C.R_STOPPED
-    cls = _measures.classify(meas, status, epsilon, roundoff)
-    alpha_norm = np.max(np.abs(alpha0), axis=1)
-    summary, radius_why = _measures.summaries(meas, cls, alpha_norm, epsilon)
-    stable, bounded = _measures.flags(meas, cls, epsilon)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        overshoot = meas[:, C.C_LARGEST] / meas[:, C.C_INITIAL]
-    diverged = cls == _measures.DIVERGED
-
-    coords = {
-        "member": variable("member", np.arange(x0.shape[0]), "ensemble member", "1"),
-        "trace": variable("trace", traced, "member whose residual norm is stored", "1"),
-        **model_coords(model, times),
-    }
-    values = {
-        "residual_norm": norms,
-        "alpha0": alpha0,
-        "alpha0_norm": alpha_norm,
-        "x0": x0,
-        "x_final": x_final,
-        "beta": meas[:, C.C_BETA],
-        "beta_reason": meas[:, C.C_REASON].astype(np.int8),
-        "gamma": meas[:, C.C_GAMMA],
-        "residual_floor": meas[:, C.C_FLOOR],
-        "floor_reached": np.nan_to_num(meas[:, C.C_FLOOR_REACHED]).astype(np.int8),
-        "max_residual": meas[:, C.C_LARGEST],
-        "final_residual": meas[:, C.C_FINAL],
-        "overshoot": overshoot,
-        "fit_start": times[0] + meas[:, C.C_FIT_START],
-        "fit_end": times[0] + meas[:, C.C_FIT_END],
-        "fit_points": meas[:, C.C_POINTS].astype(np.int64),
-        "fit_kind": meas[:, C.C_KIND].astype(np.int8),
-        "stability_class": cls,
-        "stable": stable.astype(np.int8),
-        "bounded": bounded.astype(np.int8),
-        "diverged": diverged.astype(np.int8),
-        "diverged_step": fail_step,
-        "status": status,
-        **summary,
-    }
-    if R.shape[0] > 0:
-        beta_pred = meas[:, C.C_BETA_PRED]
-        values["beta_predicted"] = beta_pred
-        with np.errstate(invalid="ignore", divide="ignore"):
-            values["beta_ratio"] = meas[:, C.C_BETA] / beta_pred
-        med = _measures.median_interval(values["beta_ratio"])
-        values["beta_ratio_median"] = med[0]
-        values["overshoot_theory"] = overshoot_theory
-    if model.energy is not None:
-        values["energy_drift"] = e1 - e0
-    values.update(extra or {})
-    values.update(_theory_values(law, model, p, scheme, run.get("tau"), x0, x_final, times,
-                                 norms, traced, alpha0, meas[:, C.C_FLOOR]))  # fmt: skip
-    for name in SINGLE_PRECISION:
-        if name in values:
-            values[name] = np.asarray(values[name], dtype=np.float32)
-    for name in COUNTS:
-        if name in values:
-            values[name] = np.asarray(values[name], dtype=np.int32)
-    data = {name: schema_variable(name, val, model) for name, val in values.items()}
-    data["residual_norm"].attrs["comment"] = (
-        f"stored as {norms.dtype}; " + data["residual_norm"].attrs["comment"]
-    )
-    data["stability_radius"].attrs["comment"] = radius_why
-    attrs = provenance(model, p, law, scheme, f"ensemble of {x0.shape[0]} members", **run)
-    attrs["residual_norm_dtype"] = str(norms.dtype)
-    return xr.Dataset(data, coords=coords, attrs=attrs)
-
-
-def _theory_values(law, model, p, scheme, tau, x0, x_final, times, norms, traced, alpha0,
-                   floor) -> dict:  # fmt: skip
-    """The theorems' predictions stored beside the measurements (:mod:`stabdae.theory`)."""
-    if law.is_constant and tau is None:  # adaptive steps: only the continuous rate
-        return {"beta_theory": theory.continuous(law.A_tilde(model))["beta"]}
-    if law.is_constant:
-        return theory.predictions(model, law, scheme, tau)
-    if not isinstance(law, Theorem5):
-        return {}
-    # Theorem 5 over the states the ensemble visited (its initial and final states)
-    states = np.concatenate([x0, x_final])
-    c = theory.theorem5(model, law, states, params=p)
-    out = {"lambda_min_W": c["lambda_min_W"], "beta_theorem5_proven": c["beta_proven"],
-           "beta_theorem5_printed": c["beta_printed"]}  # fmt: skip
-    # the Lyapunov argument bounds the 2-norm: γ = √(l_m/l₁)‖α⁰‖₂ also bounds ‖α(t)‖∞
-    alpha2 = np.linalg.norm(alpha0, axis=1)
-    for which in ("proven", "printed"):  # judged on the stored traces
-        out[f"bound_{which}_held"] = theory.bound_held(
-            times, norms, alpha2[traced], c[f"beta_{which}"], c["gamma_factor"], floor[traced]
-        ).astype(np.int8)
-    out["gamma_theorem5"] = c["gamma_factor"] * alpha2
-    return out

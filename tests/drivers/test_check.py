@@ -117,7 +117,7 @@ def test_check_probes_every_state_with_bounds_checks():
     """A write outside out that only happens away from the reference state passes Model()'s
     probe; model.check() runs every piece at its other states as Python first, with
     bounds checks, and names the piece and the state instead of corrupting memory."""
-    from toy import unit_pendulum
+    from models.toy import unit_pendulum
 
     model = unit_pendulum("far_out", f_q=f_q_writes_far_out)  # reference state x = 0
     with pytest.raises(stabdae.ModelError, match=r"f_q\(t, q, p, out\) at check state \d+ "

@@ -307,7 +307,7 @@ def test_members_stopped_by_a_status_keep_their_last_good_state():
     """A step that fails with a status (mass not SPD) leaves finite numbers, which the
     block's check after 32 steps or at a sample still sees: each member stops at its own
     step, keeps the state before it and reports the status, as ``integrate`` does."""
-    from toy import unit_pendulum
+    from models.toy import unit_pendulum
 
     model = unit_pendulum("swing_mass", mass=_mass_swing)
     x0 = np.array([[0.0, -1.0, -v, 0.0] for v in (2.0, 2.5, 3.0, 3.5, 4.0)])

@@ -185,7 +185,7 @@ def test_one_step_map_gives_the_discrete_rate_of_a_short_transient(scheme, xi):
     one-step map fitted to its pairs is R (to roundoff, which moves a Jordan block's
     eigenvalue by its square root).  (A fit of the norm's envelope over such a
     window is off by up to half.)"""
-    from affine import model as affine
+    from models.affine import model as affine
 
     slowest = xi if xi < 1 else xi - math.sqrt(xi * xi - 1)  # ω = 1
     law = stabdae.matrix([[-1.0, -2 * xi, 0.0], [0.0, 0.0, -5.0]])

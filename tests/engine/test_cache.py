@@ -133,7 +133,7 @@ def test_a_kernel_loaded_from_the_cache_does_not_capture_a_fresh_compile(tmp_pat
 
     def run(*names, cache=str(tmp_path)):
         env = dict(os.environ, STABDAE_CACHE_DIR=cache,
-                   PYTHONPATH=os.pathsep.join([str(SRC), str(SRC.parent / "tests")]))
+                   PYTHONPATH=os.pathsep.join([str(SRC), str(Path(__file__).parent)]))
         out = subprocess.run([sys.executable, "-c", INTEGRATE, *names], env=env, check=True,
                              capture_output=True, text=True, timeout=300)  # fmt: skip
         return json.loads(out.stdout.strip().splitlines()[-1])

@@ -111,7 +111,7 @@ def test_lyapunov_uses_the_symmetric_part():
 # --------------------------------------------------------------------- with ensembles
 def test_affine_constraints_follow_R_power_exactly():
     """Constraints affine in (q, v, t): the residual recursion is exactly g ← R(τÃ) g."""
-    import affine
+    from models import affine
 
     model = affine.model
     law = stabdae.baumgarte(100.0, 1.0, k=50.0)
