@@ -107,8 +107,18 @@ def main(argv=None) -> int:
         return 0
     print(f"{len(chosen)} mutants, {args.jobs} at a time", flush=True)
     start = time.perf_counter()
+    done = 0
+
+    def one(m):
+        nonlocal done
+        r = run_mutant(m, args.timeout)
+        done += 1  # the GIL makes this count safe enough for a progress line
+        print(f"[{done}/{len(chosen)}] {m.name}: {r['outcome']} {r['test']} "
+              f"({r['seconds']:.0f} s)", flush=True)
+        return r
+
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        results = list(pool.map(lambda m: run_mutant(m, args.timeout), chosen))
+        results = list(pool.map(one, chosen))
     width = max(len(m.name) for m in chosen)
     print(f"\n| {'mutant':{width}s} | place | change | outcome | caught by | s |")
     print(f"|{'-' * (width + 2)}|---|---|---|---|---|")
