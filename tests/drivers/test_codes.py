@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import stabdae
+from conftest import pendulum_scene
 from stabdae import _codes, _measures
 from stabdae._schema import _CODE_VARIABLES, SCHEMA, schema_markdown
 from stabdae.engine import decay, rhs
@@ -53,7 +54,7 @@ def test_the_kernels_integers_are_the_tables():
 def test_a_stored_code_reads_back_as_its_message():
     """What an ensemble stores decodes through the table: each member's status and β
     reason name what happened to it."""
-    model = stabdae.load_model("pendulum")
+    model = pendulum_scene()  # the scene most tests use: its kernels are compiled already
     x0 = np.tile(model.reference_state(), (3, 1))
     x0[1, 0] += 0.3
     x0[2] = np.nan  # not finite: stops at once
