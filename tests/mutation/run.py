@@ -12,6 +12,7 @@ selection that matches nothing), which fails the run like a survivor.
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import re
 import shutil
@@ -107,13 +108,11 @@ def main(argv=None) -> int:
         return 0
     print(f"{len(chosen)} mutants, {args.jobs} at a time", flush=True)
     start = time.perf_counter()
-    done = 0
+    finished = itertools.count(1)  # next() on a count is atomic: no lock for the workers
 
     def one(m):
-        nonlocal done
         r = run_mutant(m, args.timeout)
-        done += 1  # the GIL makes this count safe enough for a progress line
-        print(f"[{done}/{len(chosen)}] {m.name}: {r['outcome']} {r['test']} "
+        print(f"[{next(finished)}/{len(chosen)}] {m.name}: {r['outcome']} {r['test']} "
               f"({r['seconds']:.0f} s)", flush=True)
         return r
 
