@@ -91,21 +91,16 @@ def run_kernel(model, law, x0, divergence, nsteps):
     gives it (the reference trajectory's residuals, the linear prediction's ``R``; every
     member traced, as the C stores every member's norms)."""
     from stabdae import _ensemble as E
-    from stabdae._laws import bind_law
-    from stabdae._schemes import as_scheme
-    from stabdae.engine.ensemble.block import BLOCK
 
-    bound, scheme = bind_law(law, model), as_scheme("midpoint")
-    p, t0, M = model.param_vector(None), model.t0, x0.shape[0]
-    alpha0 = E._residual_rows(model, x0, p, t0)
-    g_ref = E._reference_residuals(model, bound, scheme, p, t0, TAU, nsteps)
-    R, _ = E._prediction(law, model, scheme, TAU, nsteps * TAU)
-    trace_row, traced = E._trace_rows("all", M, "bench")
+    run = E._run_spec("bench", model, law, "midpoint", TAU, model.t0 + nsteps * TAU, None,
+                      None, x0.shape[0], (1e-6, 1e-2), 0, TAU * SAVE_EVERY, x0, None, None,
+                      divergence, None, None, None, "float32", "all", True)  # fmt: skip
+    alpha0 = E._residual_rows(model, x0, run.p, run.t0)
+    g_ref = run.mode.reference(run)
+    status = np.zeros(x0.shape[0], dtype=np.int8)
     start = time.perf_counter()
-    out = E._run_fixed(model, bound, scheme, x0, alpha0, p, t0, TAU, nsteps, SAVE_EVERY,
-                       BLOCK, divergence, g_ref, R, trace_row, traced, "float32", None,
-                       None)  # fmt: skip
-    return time.perf_counter() - start, out["x_final"]
+    out = run.mode.integrate(run, x0, alpha0, status, g_ref)
+    return time.perf_counter() - start, out.x_final
 
 
 def run_numpy(x0):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import time
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
@@ -23,8 +24,19 @@ from . import _validate as check
 from ._codes import Status
 from ._ensemble_dataset import _ensemble_dataset, _warn_stopped
 from ._model import Model
-from .engine import decay
+from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
+from .engine.ensemble.groups import (
+    AdaptiveGrid,
+    AdaptiveMeasurement,
+    FixedGrid,
+    FixedMeasurement,
+    Outputs,
+    PairTableau,
+    Tableau,
+    inputs,
+    outputs,
+)
 from .engine.ensemble.lanes import LANES, adaptive_block_for
 from .engine.sampler import CHUNK, SAMPLING_RTOL, draw_alphas, residual_rows_for, sampler_for
 from .engine.threads import default_threads, run_chunks
@@ -37,6 +49,8 @@ DEFAULT_SAMPLES = 200
 DEFAULT_TRACES = 64
 #: steps of the linear prediction e^{Ãh} of an adaptive ensemble over its run
 PREDICTION_STEPS = 4096
+#: the most steps (accepted and rejected) an adaptive member may take
+MAX_STEPS = 10_000_000
 #: the largest reference residual history kept (steps × components; 128 MB)
 REFERENCE_MAX_ENTRIES = 16_000_000
 #: the fixed-step kernel measures the residual at every ``s``-th step, ``s`` at most this
@@ -242,7 +256,176 @@ def ensemble(
         When members stopped (diverged, singular ``S``, …), with their count per reason;
         their rows are kept up to the stop, and ``status`` says why per member.
     """
-    who = "ensemble"
+    run = _run_spec("ensemble", model, law, scheme, tau, t_end, rtol, atol, members, radius,
+                    seed, save_dt, x0, params, epsilon, divergence, block, threads, progress,
+                    residual_dtype, traces, states)  # fmt: skip
+    clock = time.perf_counter()
+    x0, alpha0, status, g_ref = _members(run, x0)
+    wall_sample = time.perf_counter() - clock
+    clock = time.perf_counter()
+    out = run.mode.integrate(run, x0, alpha0, status, g_ref)
+    wall_integrate = time.perf_counter() - clock
+    status = np.where(status != 0, status, out.status).astype(np.int8)
+    clock = time.perf_counter()
+    # the law's transient and the accumulation of per-step errors over this run (R over the
+    # run's steps, or the prediction's), from one walk over R's powers
+    peak, gain = (theory.power_norms(run.R, run.mode.prediction_steps)
+                  if run.R.shape[0] > 0 else (math.nan, math.inf))  # fmt: skip
+    times = run.mode.times(run.t0)
+    ds = _ensemble_dataset(
+        run.model, run.p, run.law, run.scheme, run.bound, times, x0, alpha0, out.norms,
+        run.traced, out.x_final, status, out.fail_step, out.e0, out.e1, run.epsilon,
+        Record(out.meas, out.codes), run.R,
+        dict(**run.mode.attrs(run), members=x0.shape[0], seed=run.seed, radius_low=run.low,
+             radius_high=run.high, epsilon=run.epsilon, divergence=run.divergence,
+             sampling_rtol=SAMPLING_RTOL,
+             threads=run.threads if run.threads is not None else default_threads()),
+        extra=run.mode.extra(out), overshoot_theory=peak, adaptive=run.adaptive,
+        roundoff=_roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
+                           run.threads, run.sampled),
+    )  # fmt: skip
+    if not run.states:
+        ds = ds.drop_vars(["x0", "x_final"])
+    # wall times (compilation included on a first call) for benchmarks; not part of the data
+    ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
+                    wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
+    _warn_stopped(run.model, status)
+    return ds
+
+
+# --------------------------------------------------------------------- the run spec
+@dataclass(frozen=True)
+class _Fixed:
+    """Fixed steps: the block-lockstep kernel (:mod:`.engine.ensemble.block`)."""
+
+    grid: FixedGrid
+    tableau: Tableau
+    kernel: object
+    stride: int  # the decay is measured at every stride-th state (:func:`measure_stride`)
+
+    @property
+    def prediction_steps(self) -> int:
+        return int(self.grid.nsteps)
+
+    def times(self, t0):
+        g = self.grid
+        return t0 + g.tau * g.save_every * np.arange(g.nsteps // g.save_every + 1)
+
+    def attrs(self, run) -> dict:
+        g = self.grid
+        return dict(tau=g.tau, t0=g.t0, t_end=g.t0 + g.nsteps * g.tau,
+                    save_dt=g.tau * g.save_every, steps=int(g.nsteps),
+                    measure_every=self.stride)  # fmt: skip
+
+    def extra(self, out) -> dict:
+        return {}
+
+    def reference(self, run):
+        """The reference trajectory's residuals (:func:`_reference_residuals`)."""
+        return _reference_residuals(run.model, run.bound, run.scheme, run.p, run.t0,
+                                    self.grid.tau, int(self.grid.nsteps), run.block,
+                                    run.rdtype, kernel=self.kernel)  # fmt: skip
+
+    def integrate(self, run, x0, alpha0, status, g_ref) -> Outputs:
+        """The kernel over chunks of blocks on threads."""
+        M = x0.shape[0]
+        out = outputs(M, x0.shape[1], run.model.n_residual, run.traced.size,
+                      self.times(run.t0).size, run.rdtype)  # fmt: skip
+        R_stride = (np.linalg.matrix_power(run.R, self.stride) if run.R.size else run.R)
+        measure = FixedMeasurement.of(run.divergence, g_ref, R_stride, self.stride,
+                                      run.trace_row)  # fmt: skip
+        args = (inputs(x0, alpha0, run.p, run.bound), self.grid, self.tableau, measure, out)
+        progress, block = run.progress, run.block
+        run_chunks(lambda lo, hi: self.kernel(*args, lo, hi), -(-M // block),
+                   threads=run.threads,
+                   progress=None if progress is None
+                   else lambda done, _: progress(min(M, done * block), M))  # fmt: skip
+        return out
+
+
+@dataclass(frozen=True)
+class _Lanes:
+    """Adaptive steps: members on lanes, each with its own steps
+    (:mod:`.engine.ensemble.lanes`)."""
+
+    grid: AdaptiveGrid
+    tableau: PairTableau
+    kernel: object
+    name: str
+
+    prediction_steps = PREDICTION_STEPS
+
+    def times(self, t0):
+        return np.concatenate([[t0], self.grid.save_times])
+
+    def attrs(self, run) -> dict:
+        g = self.grid
+        return dict(method=f"{self.name}-adaptive", rtol=g.rtol, atol=g.atol, first_step=g.h0,
+                    t0=g.t0, t_end=run.t_end, save_dt=run.save_dt)  # fmt: skip
+
+    def extra(self, out) -> dict:
+        return {"steps_accepted": out.steps, "rhs_evaluations": out.nfev}
+
+    def reference(self, run):
+        return None  # each member's steps are its own: no common reference trajectory
+
+    def integrate(self, run, x0, alpha0, status, g_ref) -> Outputs:
+        """The kernel over chunks of members on threads."""
+        M = x0.shape[0]
+        out = outputs(M, x0.shape[1], run.model.n_residual, run.traced.size,
+                      self.grid.save_times.size + 1, run.rdtype, counts=True)  # fmt: skip
+        out.status[:] = status  # members that could not be placed stay out
+        out.fail_step.fill(-1)  # (the lanes write these only where a member stops or ends)
+        out.e0.fill(np.nan)
+        out.e1.fill(np.nan)
+        measure = AdaptiveMeasurement.of(run.divergence, run.R, run.h_pred, run.trace_row)
+        args = (inputs(x0, alpha0, run.p, run.bound), self.grid, self.tableau, measure, out)
+        run_chunks(lambda lo, hi: self.kernel(*args, lo, hi), M, threads=run.threads,
+                   progress=run.progress)  # fmt: skip
+        return out
+
+
+@dataclass(frozen=True)
+class _RunSpec:
+    """An ensemble run, validated: the model, law and scheme, the members' placing, and
+    the mode (:class:`_Fixed` or :class:`_Lanes`) with its grid, tableau and kernel."""
+
+    model: Model
+    law: object
+    bound: object
+    scheme: object
+    mode: _Fixed | _Lanes
+    p: np.ndarray
+    t0: float
+    t_end: float
+    save_dt: float | None
+    block: int
+    members: int
+    low: float
+    high: float
+    seed: int
+    epsilon: float
+    divergence: float
+    threads: int | None
+    progress: object
+    rdtype: object
+    trace_row: np.ndarray
+    traced: np.ndarray
+    states: bool
+    sampled: bool
+    R: np.ndarray  # the linear prediction's one-step propagator (empty: none)
+    h_pred: float  # ... and its step
+
+    @property
+    def adaptive(self) -> bool:
+        return isinstance(self.mode, _Lanes)
+
+
+def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, seed,
+              save_dt, x0, params, epsilon, divergence, block, threads, progress,
+              residual_dtype, traces, states) -> _RunSpec:  # fmt: skip
+    """Every argument of :func:`ensemble` checked, in the order of its signature, and
+    the run spec they make (the kernel compiled or loaded once, here)."""
     model = check.model(model, who)
     law = check.law(law, who)
     adaptive = rtol is not None
@@ -287,78 +470,45 @@ def ensemble(
     if not isinstance(states, (bool, np.bool_)):
         raise TypeError(f"{who}: states must be True or False, got {states!r}")
     bound = check.bound_law(law, model, who)
-    R, h_pred = _prediction(law, model, scheme, None if adaptive else tau,
-                            float(t_end) - t0)  # fmt: skip
-
-    clock = time.perf_counter()
-    g_ref = np.zeros((0, model.n_residual))
-    sampled = x0 is None
-    if sampled:
-        targets = draw_alphas(model.n_residual, members, (low, high),
-                              np.random.default_rng(seed))  # fmt: skip
-        if adaptive:
-            x0, alpha0, status = _place(model, targets, p, t0, threads)
-        else:
-            def reference():
-                return _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block,
-                                            rdtype)  # fmt: skip
-
-            # beside the placing only while the kernel is still to be compiled or loaded
-            # (its run alone is too short to pay for a thread)
-            if ensemble_kernel_for(model, bound, scheme, block).signatures:
-                x0, alpha0, status = _place(model, targets, p, t0, threads)
-                g_ref = reference()
-            else:
-                x0, alpha0, status, g_ref = _place(model, targets, p, t0, threads,
-                                                   beside=reference)  # fmt: skip
-    else:
-        alpha0 = _residual_rows(model, x0, p, t0, threads)
-        status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
-        status = status.astype(np.int8)
-    wall_sample = time.perf_counter() - clock
-
-    M = x0.shape[0]
-    clock = time.perf_counter()
     if adaptive:
-        out = _run_adaptive(model, bound, pair, block, x0, alpha0, status, p, t0, save_times,
-                            rtol, atol, tau, divergence, R, h_pred, trace_row, traced, rdtype,
-                            threads, progress)  # fmt: skip
-        run = dict(method=f"{pair.name}-adaptive", rtol=rtol, atol=atol, first_step=tau, t0=t0,
-                   t_end=float(t_end), save_dt=save_dt)  # fmt: skip
+        R, h_pred = _prediction(law, model, scheme, float(t_end) - t0, adaptive=True)
+        mode = _Lanes(AdaptiveGrid.of(t0, save_times, tau, rtol, atol, MAX_STEPS),
+                      PairTableau.of(pair), adaptive_block_for(model, bound, pair, block),
+                      pair.name)  # fmt: skip
     else:
-        out = _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every,
-                         block, divergence, g_ref, R, trace_row, traced, rdtype, threads,
-                         progress)  # fmt: skip
-        run = dict(tau=tau, t0=t0, t_end=t0 + nsteps * tau, save_dt=tau * save_every,
-                   steps=nsteps, measure_every=out["stride"])  # fmt: skip
-    wall_integrate = time.perf_counter() - clock
-    status = np.where(status != 0, status, out["status"]).astype(np.int8)
-    clock = time.perf_counter()
-    # the law's transient and the accumulation of per-step errors over this run (R over the
-    # run's steps, or the prediction's), from one walk over R's powers
-    peak, gain = (theory.power_norms(R, PREDICTION_STEPS if adaptive else nsteps)
-                  if R.shape[0] > 0 else (math.nan, math.inf))  # fmt: skip
-    ds = _ensemble_dataset(
-        model, p, law, scheme, bound, out["times"], x0, alpha0, out["norms"], traced,
-        out["x_final"], status, out["fail_step"], out["e0"], out["e1"], epsilon, out["meas"],
-        R, dict(**run, members=M, seed=seed, radius_low=low, radius_high=high,
-                epsilon=epsilon, divergence=divergence, sampling_rtol=SAMPLING_RTOL,
-                threads=threads if threads is not None else default_threads()),
-        extra=out.get("extra"), overshoot_theory=peak,
-        roundoff=_roundoff(model, out["x_final"], status, p, float(out["times"][-1]), gain,
-                           threads, sampled),
-    )  # fmt: skip
-    if not states:
-        ds = ds.drop_vars(["x0", "x_final"])
-    # wall times (compilation included on a first call) for benchmarks; not part of the data
-    ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
-                    wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
-    _warn_stopped(model, status)
-    return ds
+        R, h_pred = _prediction(law, model, scheme, tau)
+        mode = _Fixed(FixedGrid.of(t0, tau, nsteps, save_every), Tableau.of(scheme),
+                      ensemble_kernel_for(model, bound, scheme, block),
+                      measure_stride(R))  # fmt: skip
+    return _RunSpec(model, law, bound, scheme, mode, p, t0, float(t_end), save_dt, block,
+                    members, low, high, seed, epsilon, divergence, threads, progress, rdtype,
+                    trace_row, traced, bool(states), x0 is None, R, h_pred)  # fmt: skip
+
+
+def _members(run: _RunSpec, x0):
+    """``(x0, alpha0, status, g_ref)``: the members, sampled at the seed's targets or the
+    user's own, with the reference trajectory's residuals (:meth:`_Fixed.reference`; no
+    rows: none).  The reference runs beside the placing only while the kernel is still to
+    be compiled or loaded (its run alone is too short to pay for a thread)."""
+    model, p, t0 = run.model, run.p, run.t0
+    none = np.zeros((0, model.n_residual))
+    if x0 is not None:
+        alpha0 = _residual_rows(model, x0, p, t0, run.threads)
+        status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
+        return x0, alpha0, status.astype(np.int8), none
+    targets = draw_alphas(model.n_residual, run.members, (run.low, run.high),
+                          np.random.default_rng(run.seed))  # fmt: skip
+    if run.adaptive or run.mode.kernel.signatures:
+        x0, alpha0, status = _place(model, targets, p, t0, run.threads)
+        g_ref = run.mode.reference(run)
+    else:
+        x0, alpha0, status, g_ref = _place(model, targets, p, t0, run.threads,
+                                           beside=lambda: run.mode.reference(run))  # fmt: skip
+    return x0, alpha0, status, none if g_ref is None else g_ref
 
 
 def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK,
-                         rdtype=np.float32):  # fmt: skip
+                         rdtype=np.float32, kernel=None):  # fmt: skip
     """The residual ``g`` at every step of the trajectory from the model's reference state
     (``α⁰ = 0``): the truncation error's forced response, the same for every member of a
     sampled ensemble up to ``O(‖α⁰‖)``.  Each member's decay is measured on its distance
@@ -372,18 +522,18 @@ def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK,
     ng = model.n_residual
     if (nsteps + 1) * ng > REFERENCE_MAX_ENTRIES:
         return np.zeros((0, ng))
-    kernel = ensemble_kernel_for(model, bound, scheme, block)
+    if kernel is None:
+        kernel = ensemble_kernel_for(model, bound, scheme, block)
     x0 = model.reference_state(p)[None, :]
-    out = _outputs(x0, 0, 2, rdtype)
-    out_g = np.full((nsteps + 1, ng), np.nan)
-    kernel(x0, np.zeros((1, ng)), t0, tau, nsteps, nsteps, p, bound.matrix, bound.scalars,
-           scheme.A, scheme.b, scheme.c, math.inf, np.zeros((0, ng)), np.zeros((0, 0)),
-           nsteps + 1, np.full(1, -1, dtype=np.int64), out["norms"], out["meas"],
-           out["x_final"], out["status"], out["fail_step"], out["e0"], out["e1"], out_g,
-           0, 1)  # fmt: skip
-    if out["status"][0] != 0 or not np.isfinite(out_g).all():
+    out = outputs(1, x0.shape[1], ng, 0, 2, rdtype, residuals=nsteps + 1)
+    kernel(inputs(x0, np.zeros((1, ng)), p, bound), FixedGrid.of(t0, tau, nsteps, nsteps),
+           Tableau.of(scheme),
+           FixedMeasurement.of(math.inf, np.zeros((0, ng)), np.zeros((0, 0)), nsteps + 1,
+                               np.full(1, -1)),
+           out, 0, 1)  # fmt: skip
+    if out.status[0] != 0 or not np.isfinite(out.g_out).all():
         return np.zeros((0, ng))
-    return out_g
+    return out.g_out
 
 
 def _trace_rows(traces, members: int, who: str):
@@ -408,56 +558,18 @@ def _trace_rows(traces, members: int, who: str):
     return trace_row, traced
 
 
-def _prediction(law, model, scheme, tau, span):
+def _prediction(law, model, scheme, tau_or_span, adaptive=False):
     """The one-step propagator of each member's linear prediction and its step: ``R(τÃ)``
-    for fixed steps, ``e^{Ãh}`` over ``PREDICTION_STEPS`` steps for adaptive ones; an
-    empty matrix for laws that are not constant."""
+    for fixed steps of ``tau``, ``e^{Ãh}`` over ``PREDICTION_STEPS`` steps of a run over
+    ``span`` for adaptive ones; an empty matrix for laws that are not constant."""
     if not law.is_constant:
         return np.zeros((0, 0)), 1.0
     A = np.asarray(law.A_tilde(model), dtype=float)
-    if tau is None:
-        h = span / PREDICTION_STEPS
+    if adaptive:
+        h = tau_or_span / PREDICTION_STEPS
         return np.ascontiguousarray(theory._expm(A * h)), h
+    tau = tau_or_span
     return np.ascontiguousarray(theory.step_matrix(A, scheme, tau)), tau
-
-
-def _outputs(x0, ntraced, nsave, rdtype):
-    """The per-member outputs, allocated empty: the kernels write every element (the
-    fixed-step kernel on its own threads, so that the pages are first touched there)."""
-    M = x0.shape[0]
-    return {"norms": np.empty((ntraced, nsave), dtype=rdtype), "x_final": np.empty_like(x0),
-            "status": np.empty(M, dtype=np.int8), "fail_step": np.empty(M, dtype=np.int64),
-            "e0": np.empty(M), "e1": np.empty(M),
-            "meas": np.empty((M, decay.NCOLS))}  # fmt: skip
-
-
-def _run_fixed(model, bound, scheme, x0, alpha0, p, t0, tau, nsteps, save_every, block,
-               divergence, g_ref, R, trace_row, traced, rdtype, threads,
-               progress) -> dict:  # fmt: skip
-    """The block-lockstep kernel over chunks of blocks on threads."""
-    M = x0.shape[0]
-    out = _outputs(x0, traced.size, nsteps // save_every + 1, rdtype)
-    out["times"] = t0 + tau * save_every * np.arange(nsteps // save_every + 1)
-    kernel = ensemble_kernel_for(model, bound, scheme, block)
-    alpha0 = np.ascontiguousarray(alpha0)
-    stride = measure_stride(R)
-    no_residuals = np.zeros((0, model.n_residual))
-    R_stride = np.ascontiguousarray(np.linalg.matrix_power(R, stride)) if R.size else R
-    out["stride"] = stride
-
-    def chunk(lo, hi):
-        kernel(x0, alpha0, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
-               scheme.A, scheme.b, scheme.c, divergence, g_ref, R_stride, stride,
-               trace_row, out["norms"],
-               out["meas"], out["x_final"], out["status"], out["fail_step"], out["e0"],
-               out["e1"], no_residuals, lo, hi)  # fmt: skip
-
-    run_chunks(
-        chunk, -(-M // block), threads=threads,
-        progress=None if progress is None
-        else lambda done, _: progress(min(M, done * block), M),
-    )  # fmt: skip
-    return out
 
 
 def measure_stride(R) -> int:
@@ -481,35 +593,6 @@ def measure_stride(R) -> int:
     if change == 0.0:  # every mode on the unit circle at angle 0: nothing moves
         return MAX_STRIDE
     return int(min(MAX_STRIDE, max(1, math.floor(STRIDE_CHANGE / change))))
-
-
-def _run_adaptive(model, bound, pair, lanes, x0, alpha0, status, p, t0, save_times, rtol,
-                  atol, first_step, divergence, R, h_pred, trace_row, traced, rdtype, threads,
-                  progress) -> dict:  # fmt: skip
-    """The per-member adaptive kernel over chunks of members on threads."""
-    M = x0.shape[0]
-    out = _outputs(x0, traced.size, save_times.shape[0] + 1, rdtype)
-    out["times"] = np.concatenate([[t0], save_times])
-    out["fail_step"].fill(-1)
-    out["e0"].fill(np.nan)
-    out["e1"].fill(np.nan)
-    out["status"][:] = status  # members that could not be placed stay out
-    steps = np.zeros(M, dtype=np.int64)
-    nfev = np.zeros(M, dtype=np.int64)
-    kernel = adaptive_block_for(model, bound, pair, lanes)
-    sc = pair.scheme
-    alpha0 = np.ascontiguousarray(alpha0)
-
-    def chunk(lo, hi):
-        kernel(x0, alpha0, t0, save_times, p, bound.matrix, bound.scalars, sc.A, sc.b,
-               pair.error, sc.c, pair.error_order, rtol, atol, first_step, 10_000_000,
-               divergence, R, h_pred, trace_row, out["norms"], out["meas"], out["x_final"],
-               out["status"], out["fail_step"], out["e0"], out["e1"], steps, nfev, lo,
-               hi)  # fmt: skip
-
-    run_chunks(chunk, M, threads=threads, progress=progress)
-    out["extra"] = {"steps_accepted": steps, "rhs_evaluations": nfev}
-    return out
 
 
 #: members whose final states set the roundoff level the growth test compares with

@@ -38,18 +38,19 @@ def _warn_stopped(model, status) -> None:
 
 def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
                       x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
-                      extra=None, roundoff=0.0, overshoot_theory=math.nan):  # fmt: skip
-    C = decay
-    meas[status != 0, C.C_BETA_PRED] = np.nan  # (not placed: measured on nothing)
-    for c in (C.C_BETA, C.C_GAMMA):
-        meas[status != 0, c] = np.nan
-    meas[(status != 0) & (meas[:, C.C_REASON] == C.R_FITTED), C.C_REASON] = C.R_STOPPED
+                      extra=None, roundoff=0.0, overshoot_theory=math.nan,
+                      adaptive=False):  # fmt: skip
+    stopped = status != 0
+    for name in ("beta_predicted", "beta", "gamma"):  # (not placed: measured on nothing)
+        meas[name][stopped] = np.nan
+    reason = meas["reason"]
+    reason[stopped & (reason == decay.R_FITTED)] = decay.R_STOPPED
     cls = _measures.classify(meas, status, epsilon, roundoff)
     alpha_norm = np.max(np.abs(alpha0), axis=1)
     summary, radius_why = _measures.summaries(meas, cls, alpha_norm, epsilon)
     stable, bounded = _measures.flags(meas, cls, epsilon)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        overshoot = meas[:, C.C_LARGEST] / meas[:, C.C_INITIAL]
+        overshoot = meas["largest"] / meas["initial"]
     diverged = cls == _measures.DIVERGED
 
     coords = {
@@ -63,18 +64,18 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
         "alpha0_norm": alpha_norm,
         "x0": x0,
         "x_final": x_final,
-        "beta": meas[:, C.C_BETA],
-        "beta_reason": meas[:, C.C_REASON].astype(np.int8),
-        "gamma": meas[:, C.C_GAMMA],
-        "residual_floor": meas[:, C.C_FLOOR],
-        "floor_reached": np.nan_to_num(meas[:, C.C_FLOOR_REACHED]).astype(np.int8),
-        "max_residual": meas[:, C.C_LARGEST],
-        "final_residual": meas[:, C.C_FINAL],
+        "beta": meas["beta"],
+        "beta_reason": reason.astype(np.int8),
+        "gamma": meas["gamma"],
+        "residual_floor": meas["floor"],
+        "floor_reached": meas["floor_reached"].astype(np.int8),
+        "max_residual": meas["largest"],
+        "final_residual": meas["final"],
         "overshoot": overshoot,
-        "fit_start": times[0] + meas[:, C.C_FIT_START],
-        "fit_end": times[0] + meas[:, C.C_FIT_END],
-        "fit_points": meas[:, C.C_POINTS].astype(np.int64),
-        "fit_kind": meas[:, C.C_KIND].astype(np.int8),
+        "fit_start": times[0] + meas["fit_start"],
+        "fit_end": times[0] + meas["fit_end"],
+        "fit_points": meas["fit_points"],
+        "fit_kind": meas["fit_kind"].astype(np.int8),
         "stability_class": cls,
         "stable": stable.astype(np.int8),
         "bounded": bounded.astype(np.int8),
@@ -84,18 +85,18 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
         **summary,
     }
     if R.shape[0] > 0:
-        beta_pred = meas[:, C.C_BETA_PRED]
+        beta_pred = meas["beta_predicted"]
         values["beta_predicted"] = beta_pred
         with np.errstate(invalid="ignore", divide="ignore"):
-            values["beta_ratio"] = meas[:, C.C_BETA] / beta_pred
+            values["beta_ratio"] = meas["beta"] / beta_pred
         med = _measures.median_interval(values["beta_ratio"])
         values["beta_ratio_median"] = med[0]
         values["overshoot_theory"] = overshoot_theory
     if model.energy is not None:
         values["energy_drift"] = e1 - e0
     values.update(extra or {})
-    values.update(_theory_values(law, model, p, scheme, run.get("tau"), x0, x_final, times,
-                                 norms, traced, alpha0, meas[:, C.C_FLOOR]))  # fmt: skip
+    values.update(_theory_values(law, model, p, scheme, run.get("tau"), adaptive, x0, x_final,
+                                 times, norms, traced, alpha0, meas["floor"]))  # fmt: skip
     for name in SINGLE_PRECISION:
         if name in values:
             values[name] = np.asarray(values[name], dtype=np.float32)
@@ -112,10 +113,11 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _theory_values(law, model, p, scheme, tau, x0, x_final, times, norms, traced, alpha0,
-                   floor) -> dict:  # fmt: skip
-    """The theorems' predictions stored beside the measurements (:mod:`stabdae.theory`)."""
-    if law.is_constant and tau is None:  # adaptive steps: only the continuous rate
+def _theory_values(law, model, p, scheme, tau, adaptive, x0, x_final, times, norms, traced,
+                   alpha0, floor) -> dict:  # fmt: skip
+    """The theorems' predictions stored beside the measurements (:mod:`stabdae.theory`);
+    for adaptive steps only the continuous rate (no step ``tau``)."""
+    if law.is_constant and adaptive:
         return {"beta_theory": theory.continuous(law.A_tilde(model))["beta"]}
     if law.is_constant:
         return theory.predictions(model, law, scheme, tau)

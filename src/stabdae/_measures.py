@@ -59,9 +59,10 @@ ROUNDOFF_MARGIN = 10.0
 _BLOWN_UP = (Status.DIVERGED, Status.NONFINITE_STATE, Status.SINGULAR_S, Status.MASS_NOT_SPD)
 
 
-def classify(meas: np.ndarray, status: np.ndarray, epsilon: float,
+def classify(meas: decay.Record, status: np.ndarray, epsilon: float,
              roundoff: float = 0.0) -> np.ndarray:  # fmt: skip
-    """The stability class of each member (int8, codes of :data:`CLASSES`).
+    """The stability class of each member (int8, codes of :data:`CLASSES`) from its
+    measurement record ``meas``.
 
     ``roundoff``: the size of the residual that roundoff alone can build up by the end of
     the run (:func:`roundoff_level` at the final states, times the law's
@@ -69,8 +70,8 @@ def classify(meas: np.ndarray, status: np.ndarray, epsilon: float,
     last fifth rises above ``ROUNDOFF_MARGIN`` times that: below it, a residual that
     rises is roundoff growing with the size of the state (a model whose coordinates
     drift), not an instability."""
-    initial, largest = meas[:, decay.C_INITIAL], meas[:, decay.C_LARGEST]
-    w2, w3, w4 = meas[:, decay.C_W2], meas[:, decay.C_W3], meas[:, decay.C_W4]
+    initial, largest = meas["initial"], meas["largest"]
+    w2, w3, w4 = meas["w2"], meas["w3"], meas["w4"]
     with np.errstate(invalid="ignore"):
         growing = decay.grows(w2, w3, w4) & (w4 > ROUNDOFF_MARGIN * roundoff)
         fell = w4 < initial
@@ -168,7 +169,7 @@ def flags(meas, cls, epsilon):
     (Definition 2)."""
     stable = np.isin(cls, STABLE)
     with np.errstate(invalid="ignore"):
-        return stable, stable & (meas[:, decay.C_LARGEST] <= epsilon)
+        return stable, stable & (meas["largest"] <= epsilon)
 
 
 def summaries(meas, cls, alpha_norm, epsilon) -> dict:
@@ -176,7 +177,7 @@ def summaries(meas, cls, alpha_norm, epsilon) -> dict:
     ran = cls != NOT_RUN
     stable, bounded = flags(meas, cls, epsilon)
     n = int(ran.sum())
-    beta = meas[:, decay.C_BETA]
+    beta = meas["beta"]
     out = {"members_run": n, "members_stable": int((stable & ran).sum()),
            "members_bounded": int((bounded & ran).sum()),
            "members_diverged": int((cls == DIVERGED).sum()),

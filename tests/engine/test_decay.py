@@ -25,10 +25,10 @@ def test_measures_of_stored_traces_match_numpy():
     for j in range(40):
         row = norms[j]
         n = int(np.argmin(np.isfinite(row))) if not np.isfinite(row).all() else row.size
-        assert meas[j, decay.C_INITIAL] == row[0]
-        assert meas[j, decay.C_LARGEST] == row[:n].max()
-        assert meas[j, decay.C_FINAL] == row[n - 1]
-    assert meas[3, decay.C_REASON] == decay.R_STOPPED and np.isnan(meas[3, decay.C_BETA])
+        assert meas["initial"][j] == row[0]
+        assert meas["largest"][j] == row[:n].max()
+        assert meas["final"][j] == row[n - 1]
+    assert meas["reason"][3] == decay.R_STOPPED and np.isnan(meas["beta"][3])
 
 
 def test_ladder_records_are_the_right_envelope():
@@ -178,12 +178,12 @@ def test_fitted_rate_of_exact_decays(c0):
         np.exp(-beta * t) * (1.2 + np.cos(15.0 * t)),
     ]) + floor  # fmt: skip
     meas = decay.measure_traces(traces, t)
-    got, gamma = meas[:, decay.C_BETA], meas[:, decay.C_GAMMA]
+    got, gamma = meas["beta"], meas["gamma"]
     np.testing.assert_allclose(got, beta, rtol=0.01)
-    assert meas[2, decay.C_KIND] == decay.K_OSCILLATING
-    assert np.all(meas[:, decay.C_FLOOR] < 1.5e-9) and np.all(meas[:, decay.C_FLOOR] > 1e-9)
+    assert meas["fit_kind"][2] == decay.K_OSCILLATING
+    assert np.all(meas["floor"] < 1.5e-9) and np.all(meas["floor"] > 1e-9)
     for j in range(3):  # γ e^{−βt} bounds the trace where it lies above 1000 × its floor
-        above = traces[j] > 1000 * meas[j, decay.C_FLOOR]
+        above = traces[j] > 1000 * meas["floor"][j]
         assert np.all(traces[j, above] <= gamma[j] * np.exp(-got[j] * t[above]) * 1.2)
         assert np.any(traces[j, above] >= gamma[j] * np.exp(-got[j] * t[above]) / 1.2)
 
@@ -198,8 +198,8 @@ def test_refined_shift_gives_the_repeated_eigenvalue_rate(c0):
     floor = 1e-13 * (1.0 + 0.5 * np.random.default_rng(2).random(t.size))
     trace = np.abs(c0 + 10.0 * t) * np.exp(-10.0 * t) + floor
     meas = decay.measure_traces(trace[None, :], t)
-    assert meas[0, decay.C_KIND] == decay.K_POLYNOMIAL
-    assert abs(meas[0, decay.C_BETA] / 10.0 - 1) < 0.002
+    assert meas["fit_kind"][0] == decay.K_POLYNOMIAL
+    assert abs(meas["beta"][0] / 10.0 - 1) < 0.002
 
 
 def test_log_normal_is_the_library_logarithm_to_an_ulp():
@@ -313,6 +313,6 @@ def test_no_transient_or_growth_gives_no_rate_and_says_why():
     flat = 1e-6 * (1.0 + 0.5 * np.random.default_rng(3).random(t.size))
     growing = 1e-6 * np.exp(3.0 * t)
     meas = decay.measure_traces(np.stack([flat, growing]), t)
-    assert np.isnan(meas[:, decay.C_BETA]).all()
-    assert meas[0, decay.C_REASON] == decay.R_NO_TRANSIENT
-    assert meas[1, decay.C_REASON] == decay.R_NOT_DECAYING
+    assert np.isnan(meas["beta"]).all()
+    assert meas["reason"][0] == decay.R_NO_TRANSIENT
+    assert meas["reason"][1] == decay.R_NOT_DECAYING

@@ -15,12 +15,14 @@ one floor up do, once).  By role:
 * :mod:`.rk` — explicit Runge–Kutta steps: :mod:`.rk.steps` (the fixed step, looped and
   generated, side by side), :mod:`.rk.control` (step-size control of the embedded pairs),
   :mod:`.rk.adaptive` (the adaptive loop of one trajectory and its generated attempt);
-* :mod:`.ensemble` — the ensemble kernels: :mod:`.ensemble.block` (fixed steps, blocks of
-  members in lockstep) and :mod:`.ensemble.lanes` (adaptive steps, members on lanes);
+* :mod:`.ensemble` — the ensemble kernels: :mod:`.ensemble.groups` (their arguments in
+  named groups), :mod:`.ensemble.block` (fixed steps, blocks of members in lockstep) and
+  :mod:`.ensemble.lanes` (adaptive steps, members on lanes);
 * :mod:`.decay` — the in-kernel measurement of the decay rate: :mod:`.decay.record`,
   :mod:`.decay.ladder`, :mod:`.decay.fit`, :mod:`.decay.member`, :mod:`.decay.onestep`,
   :mod:`.decay.traces`;
 * :mod:`.sampler` — placing initial states at prescribed constraint perturbations;
 * :mod:`.threads` — running ``nogil`` kernels over chunks of members on a thread pool;
-* :mod:`.cache` — per-model memo of the compiled closures and their on-disk cache.
+* :mod:`.cache` — the compile spec (:class:`.cache.Spec`), the per-model memo of the
+  compiled closures and their on-disk cache.
 """

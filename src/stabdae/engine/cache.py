@@ -9,7 +9,8 @@ repeats and the cache never hits.  Here a kernel gets an explicit key instead:
 * the model: for each of its functions the qualified name and the SHA-256 of the source
   file that defines it (so editing a model file, or any function in it, recompiles), and
   the sizes ``n, m, k``;
-* the kernel's own compile-time choices (law kind, user law function, stage count, block).
+* the kernel's own compile-time choices, one :class:`Spec` per factory (law kind, user law
+  function, scheme pattern, block, …): the same object is the memo key on the model.
 
 Functions defined without a source file (an interactive session) have no fingerprint;
 their kernels are compiled as before and not cached.  A change in a helper function that a
@@ -24,6 +25,7 @@ processes are safe.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import inspect
 import os
@@ -31,6 +33,7 @@ import shutil
 import sys
 import types
 import warnings
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
@@ -53,18 +56,50 @@ else:
 from .fma import HOST_FMA
 from .jit import JIT
 
-__all__ = ["cache_dir", "clear", "fingerprint", "function_fingerprint", "kernel_key", "keyed_cache",
-           "library_fingerprint",
-           "memo", "tag"]
+__all__ = ["Spec", "cache_dir", "clear", "fingerprint", "function_fingerprint", "keyed_cache",
+           "library_fingerprint", "memo", "tag"]  # fmt: skip
 
 
-def memo(model, key: tuple, build):
-    """``build()`` once per model and ``key``, kept on the model: every kernel factory
+@dataclass(frozen=True)
+class Spec:
+    """What a compiled piece is built from besides the model: one object that is both
+    its memo key on the model (:func:`memo`) and, with the model's fingerprint, its
+    on-disk key (:meth:`key`).  A factory lists its compile-time choices here once.
+
+    ``law_fn`` (the user's law function, or None) is compared by identity in the memo and
+    keyed by its fingerprint on disk; every other field is a plain value."""
+
+    kind: str  #: which factory: "rhs", "stepper", "block", "lanes", …
+    law: int = -1  #: the law kind (:class:`stabdae._codes.LawKind`; −1: none)
+    law_fn: object = None
+    multiplier: str = "ldl"  #: "ldl" or "lstsq"
+    pattern: tuple = ()  #: the scheme's (or pair's) pattern of nonzero coefficients
+    stages: tuple = ()  #: stage counts (a pair's: s and the error estimate's)
+    combined: bool = False  #: a pair's combined error norm (DOP853)
+    block: int = 0  #: members per block, or lanes
+    n_params: int = 0
+    law_shape: tuple = ()
+    pooled: int = -1  #: the decay measurement's pooled constraints (−1: the full map)
+    sparse: bool = False  #: the sparse path of the right-hand side
+
+    def key(self, base: str | None, *parts) -> str | None:
+        """The on-disk key of this piece for a model (or pieces) keyed ``base``, and
+        ``parts`` (one factory's several kernels: a name each); None (not cached) where
+        ``base`` is None or the law function has no source file."""
+        if base is None:
+            return None
+        fields = tuple((f.name, optional_fingerprint(self.law_fn) if f.name == "law_fn"
+                        else getattr(self, f.name)) for f in dataclasses.fields(self))  # fmt: skip
+        return fingerprint(base, fields, *parts)
+
+
+def memo(model, spec: Spec, build):
+    """``build()`` once per model and ``spec``, kept on the model: every kernel factory
     returns new closures, and every new closure is a new compilation."""
     store = model._kernel_cache
-    if key not in store:
-        store[key] = build()
-    return store[key]
+    if spec not in store:
+        store[spec] = build()
+    return store[spec]
 
 
 def cache_dir() -> Path | None:
@@ -194,11 +229,6 @@ def _has_unknown(part) -> bool:
     if part is UNKNOWN:
         return True
     return isinstance(part, tuple) and any(_has_unknown(p) for p in part)
-
-
-def kernel_key(base: str | None, *parts) -> str | None:
-    """The key of a kernel built on kernels keyed ``base`` (``None`` stays ``None``)."""
-    return None if base is None else fingerprint(base, *parts)
 
 
 class _Unknown:

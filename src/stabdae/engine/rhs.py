@@ -34,13 +34,13 @@ from __future__ import annotations
 
 import math
 from collections import namedtuple
-from types import SimpleNamespace
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from .._codes import LawKind, Status
-from .cache import fingerprint, memo, optional_fingerprint, tag
+from .cache import Spec, fingerprint, memo, optional_fingerprint, tag
 from .fma import fma
 from .jit import python_function
 from .linalg import (
@@ -176,11 +176,65 @@ def kernels_for(model, bound, multiplier: str = "ldl") -> Kernels:
     (``A``, ``L``, gains) are runtime arguments, so sweeping them reuses the same kernels.
     ``acpr`` laws need ``multiplier="ldl"`` (the drivers check it).
     """
-    return memo(model, (bound.code, bound.fn, multiplier),
-                lambda: _build(model, bound.code, bound.fn, multiplier == "lstsq"))
+    spec = Spec("rhs", law=bound.code, law_fn=bound.fn, multiplier=multiplier)
+    return memo(model, spec, lambda: _build(model, spec))
 
 
-def _pieces(model, sparse: bool) -> SimpleNamespace:
+class Pieces(NamedTuple):
+    """The compiled pieces of a model that no law touches (:func:`_pieces`): its sizes and
+    which functions it has, its functions with the library's flags, ``residual``,
+    ``project``, ``energy``, the workspace builders, the sparse path's helpers and index
+    lists (unused, and typed placeholders, on the dense path), and ``key``, the on-disk
+    key of the model's part (None: a function without a source file)."""
+
+    n: int
+    m: int
+    k: int
+    r: int
+    ng: int
+    HAS_MASS: bool
+    HAS_HT: bool
+    SPARSE: bool
+    mass: object
+    forces: object
+    f_accel: object
+    h_t: object
+    residual: object
+    project: object
+    energy: object
+    make_workspace: object
+    stack_workspace: object
+    sparse_Y: object
+    sparse_S: object
+    FPTR: np.ndarray
+    FCOL: np.ndarray
+    CPTR: np.ndarray
+    CROW: np.ndarray
+    HQPTR: np.ndarray
+    HQCOL: np.ndarray
+    LPTR: np.ndarray
+    LCOL: np.ndarray
+    LTPTR: np.ndarray
+    LROW: np.ndarray
+    key: str | None
+
+
+class Plan(NamedTuple):
+    """The dense path's linear algebra written out for a model's structural zeros
+    (:func:`_structured`)."""
+
+    factor_M: object
+    solve_M: object
+    solve_columns_M: object
+    factor_S: object
+    solve_S: object
+    load_Ft: object
+    gram: object
+    add_Fz: object
+    accel: object
+
+
+def _pieces(model, sparse: bool) -> Pieces:
     """The compiled pieces of ``model`` that no law touches: its functions with the
     library's flags, the workspace, ``residual``, ``project``, ``energy`` (and the sparse
     path's helpers where ``sparse``), shared by the kernels of every law kind (the sampler
@@ -358,20 +412,23 @@ def _pieces(model, sparse: bool) -> SimpleNamespace:
             v[i] = x[n + i]
         return energy_fn(t, q, v, p)
 
-    key = fingerprint(
-        "pieces", n, m, k, model.structure_key() if SPARSE else "dense",
+    model_key = fingerprint(
+        n, m, k, model.structure_key() if SPARSE else "dense",
         tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
         optional_fingerprint(model.energy),
     )  # fmt: skip
+    key = Spec("pieces", sparse=sparse).key(model_key)
     tag(key, residual, energy, project, make_workspace, stack_workspace)
-    return SimpleNamespace(**locals())
+    return Pieces(n, m, k, r, ng, HAS_MASS, HAS_HT, SPARSE, mass, forces, f_accel, h_t, residual,
+                  project, energy, make_workspace, stack_workspace, sparse_Y, sparse_S, FPTR,
+                  FCOL, CPTR, CROW, HQPTR, HQCOL, LPTR, LCOL, LTPTR, LROW, key)  # fmt: skip
 
 
 def _nested(a) -> tuple:
     return tuple(tuple(bool(v) for v in row) for row in a)
 
 
-def _structured(model, n: int, m: int, k: int) -> SimpleNamespace | None:
+def _structured(model, n: int, m: int, k: int) -> Plan | None:
     """The dense path's linear algebra written out for the model's structural zeros.
 
     A mass matrix that is not diagonal rules out the sparse path (:mod:`.sparsity`), but
@@ -431,7 +488,7 @@ def _structured(model, n: int, m: int, k: int) -> SimpleNamespace | None:
         accel += [f"xdot[{j}] = v[{j}]", f"xdot[{n + j}] = s"]
     tag_ = model.structure_key()[:8]
     mkey = _nested(M) if has_mass else None
-    return SimpleNamespace(
+    return Plan(
         factor_M=ldl_factor_for(n, mkey) if has_mass else None,
         solve_M=ldl_solve_for(n, mkey) if has_mass else None,
         solve_columns_M=ldl_solve_columns_for(n, r, mkey, _nested(F.T)) if has_mass else None,
@@ -444,11 +501,12 @@ def _structured(model, n: int, m: int, k: int) -> SimpleNamespace | None:
     )
 
 
-def _build(model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
+def _build(model, spec: Spec) -> Kernels:
+    law_code, law_fn, lstsq = spec.law, spec.law_fn, spec.multiplier == "lstsq"
     # The sparse path (:mod:`.sparsity`) where the model's structure pays for it; not for
     # the least-squares multiplier or the correction of Ascher et al., which stay dense.
     sparse = not (lstsq or law_code == LAW_ACPR) and model.sparse_structure() is not None
-    P = memo(model, ("pieces", sparse), lambda: _pieces(model, sparse))
+    P = memo(model, Spec("pieces", sparse=sparse), lambda: _pieces(model, sparse))
     # compile-time constants of the right-hand side's closure
     n, m, k, r, ng = P.n, P.m, P.k, P.r, P.ng
     HAS_MASS, HAS_HT, SPARSE = P.HAS_MASS, P.HAS_HT, P.SPARSE
@@ -470,7 +528,7 @@ def _build(model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     # least-squares multiplier or the correction of Ascher et al., which read all of S)
     plan = None
     if not (SPARSE or lstsq or law_code == LAW_ACPR):
-        plan = memo(model, ("structured",), lambda: _structured(model, n, m, k))
+        plan = memo(model, Spec("structured"), lambda: _structured(model, n, m, k))
     STRUCTURED = plan is not None
     if STRUCTURED:
         factor_S, solve_S = plan.factor_S, plan.solve_S
@@ -647,8 +705,7 @@ def _build(model, law_code: int, law_fn, lstsq: bool = False) -> Kernels:
     # None (no cache) where that is
     flags = (("lstsq",) if lstsq else ()) + (
         ("structured", model.structure_key()) if STRUCTURED else ())
-    key = P.key and fingerprint("kernels", P.key, law_code, optional_fingerprint(law_fn),
-                                *flags)  # fmt: skip
+    key = spec.key(P.key, *flags)
     tag(key, rhs)
     return Kernels(rhs, residual, energy, project, make_workspace, stack_workspace, n, m, k,
                    ng, key)

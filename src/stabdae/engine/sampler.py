@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .._codes import Status
-from .cache import kernel_key, keyed_cache, memo, tag
+from .cache import Spec, keyed_cache, memo, tag
 from .linalg import ldl_inplace, ldl_solve_inplace
 from .rhs import LAW_CONSTANT, kernels_for
 
@@ -47,17 +47,18 @@ class _Unstabilized:
 
 def sampler_for(model):
     """The compiled perturbation sampler of ``model`` (memoized)."""
-    return memo(model, ("sampler",),
-                lambda: build_sampler(kernels_for(model, _Unstabilized)))  # fmt: skip
+    spec = Spec("sampler")
+    return memo(model, spec, lambda: build_sampler(kernels_for(model, _Unstabilized), spec))
 
 
 def residual_rows_for(model):
     """The compiled ``g(x_i, t0)`` of rows of states of ``model`` (memoized)."""
-    return memo(model, ("residual_rows",),
-                lambda: build_residual_rows(kernels_for(model, _Unstabilized)))  # fmt: skip
+    spec = Spec("residual_rows")
+    return memo(model, spec,
+                lambda: build_residual_rows(kernels_for(model, _Unstabilized), spec))
 
 
-def build_sampler(K):
+def build_sampler(K, spec: Spec):
     """Compiled Gauss–Newton placement for the kernels ``K``, over chunks of 64 members
 (:data:`CHUNK`; run on threads by :func:`.threads.run_chunks`)."""
     residual, make_workspace = K.residual, K.make_workspace
@@ -187,12 +188,12 @@ def build_sampler(K):
                 for i in range(ng):
                     alpha_out[j, i] = gp[i]
 
-    key = kernel_key(K.key, "sample")
+    key = spec.key(K.key)
     tag(key, place, jacobian)
     return keyed_cache(sample_kernel, key)
 
 
-def build_residual_rows(K):
+def build_residual_rows(K, spec: Spec):
     """Compiled ``g(x_i, t0)`` for the rows of an array of states, over chunks of
     :data:`CHUNK` rows."""
     residual, make_workspace = K.residual, K.make_workspace
@@ -210,7 +211,7 @@ def build_residual_rows(K):
             for i in range(ng):
                 out[j, i] = g[i]
 
-    return keyed_cache(residual_rows, kernel_key(K.key, "residual_rows"))
+    return keyed_cache(residual_rows, spec.key(K.key))
 
 
 def draw_alphas(ng: int, members: int, radius, rng: np.random.Generator) -> np.ndarray:

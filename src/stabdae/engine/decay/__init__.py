@@ -51,7 +51,8 @@ estimator does to a window cancels in the ratio of measured to predicted rate.
 
 The package, by role (each module's docstring says more):
 
-* :mod:`.record` — the measurement record's columns, reasons and kinds of fit;
+* :mod:`.record` — the measurement record's columns by name and kind, reasons and
+  kinds of fit;
 * :mod:`.ladder` — levels from a float's bits, the ladder and its envelope points;
 * :mod:`.fit` — the window and the fits of the envelope; the growth predicate;
 * :mod:`.member` — one member's begin, observe, finish and prediction;
@@ -130,13 +131,9 @@ from .record import (  # noqa: F401
     C_FIT_END,
     C_FIT_START,
     C_FLOOR,
-    C_FLOOR_REACHED,
     C_GAMMA,
     C_INITIAL,
-    C_KIND,
     C_LARGEST,
-    C_POINTS,
-    C_REASON,
     C_SHIFT,
     C_W0,
     C_W1,
@@ -144,18 +141,26 @@ from .record import (  # noqa: F401
     C_W3,
     C_W4,
     COLUMNS,
+    FLOATS,
+    I_FLOOR_REACHED,
+    I_KIND,
+    I_POINTS,
+    I_REASON,
+    INTEGERS,
     K_EXPONENTIAL,
     K_MAP,
     K_NONE,
     K_OSCILLATING,
     K_POLYNOMIAL,
     KINDS,
+    NCODES,
     NCOLS,
     R_FITTED,
     R_NO_TRANSIENT,
     R_NOT_DECAYING,
     R_STOPPED,
     REASONS,
+    Record,
 )
 from .traces import (  # noqa: F401
     measure_traces,

@@ -17,10 +17,10 @@ from .record import (
     C_FIT_END,
     C_FIT_START,
     C_GAMMA,
-    C_KIND,
-    C_POINTS,
-    C_REASON,
     C_SHIFT,
+    I_KIND,
+    I_POINTS,
+    I_REASON,
     K_EXPONENTIAL,
     K_NONE,
     K_OSCILLATING,
@@ -322,23 +322,24 @@ def _window(rt, ry, n, floor, still_decaying):
 
 
 @njit(cache=True)
-def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out):
+def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code):
     """β, γ and the fit's window, kind and shift from the ``n`` envelope points into
-    ``out`` (columns of :data:`COLUMNS`; ``reason`` too)."""
+    ``out`` and ``code`` (a member's row of the record's floats and integers; ``reason``
+    too)."""
     out[C_BETA] = math.nan
     out[C_GAMMA] = math.nan
     out[C_FIT_START] = math.nan
     out[C_FIT_END] = math.nan
-    out[C_POINTS] = 0
-    out[C_KIND] = K_NONE
+    code[I_POINTS] = 0
+    code[I_KIND] = K_NONE
     out[C_SHIFT] = math.nan
     if n < 2 or not math.isfinite(ry[0]):
-        out[C_REASON] = R_NOT_DECAYING if n < 2 else R_NO_TRANSIENT
+        code[I_REASON] = R_NOT_DECAYING if n < 2 else R_NO_TRANSIENT
         return
     start, end = _window(rt, ry, n, floor, still_decaying)
     if end == 0:
         # no decade of decay above the floor: growing, or started near its floor
-        out[C_REASON] = (R_NOT_DECAYING if grows(out[C_D2], out[C_D3], out[C_D4])
+        code[I_REASON] = (R_NOT_DECAYING if grows(out[C_D2], out[C_D3], out[C_D4])
                          else R_NO_TRANSIENT)  # fmt: skip
         return
     beta, sse = _fit_linear(rt, ry, start, end)
@@ -354,11 +355,11 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out):
         shift = math.nan
     out[C_FIT_START] = rt[start]
     out[C_FIT_END] = rt[end - 1]
-    out[C_POINTS] = end - start
-    out[C_KIND] = kind
+    code[I_POINTS] = end - start
+    code[I_KIND] = kind
     out[C_SHIFT] = shift
     if not (beta > 0.0):
-        out[C_REASON] = R_NOT_DECAYING
+        code[I_REASON] = R_NOT_DECAYING
         return
     top = -math.inf  # the exponential is monotone: one call, on the largest exponent
     for i in range(end):
@@ -366,7 +367,7 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out):
     gamma = math.exp(top)
     out[C_BETA] = beta
     out[C_GAMMA] = gamma
-    out[C_REASON] = R_FITTED
+    code[I_REASON] = R_FITTED
 
 
 @njit(cache=True)

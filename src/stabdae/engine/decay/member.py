@@ -20,18 +20,19 @@ from .record import (
     C_FIT_END,
     C_FIT_START,
     C_FLOOR,
-    C_FLOOR_REACHED,
     C_GAMMA,
     C_INITIAL,
-    C_KIND,
     C_LARGEST,
-    C_POINTS,
-    C_REASON,
     C_SHIFT,
     C_W0,
     C_W4,
+    I_FLOOR_REACHED,
+    I_KIND,
+    I_POINTS,
+    I_REASON,
     K_MAP,
     K_NONE,
+    NCODES,
     NCOLS,
     R_FITTED,
     R_NOT_DECAYING,
@@ -61,13 +62,15 @@ def observe(lt, lv, base, meas, j, row, t, v, d, window):  # costs as much as th
 
 
 @njit(cache=True)
-def begin(lt, lv, base, meas, j, row, g0, d0):
+def begin(lt, lv, base, meas, codes, j, row, g0, d0):
     """Start member ``row`` on ladder row ``j`` with its initial norms (as
-    :func:`observe`'s)."""
+    :func:`observe`'s); every column of its record is written here or at its end."""
     ladder_clear(lt, j)
     base[j] = ladder_base(d0)
     for c in range(NCOLS):
         meas[row, c] = math.nan
+    for c in range(NCODES):
+        codes[row, c] = 0
     for w in range(5):
         meas[row, C_W0 + w] = -math.inf
     for w in range(3):
@@ -77,16 +80,16 @@ def begin(lt, lv, base, meas, j, row, g0, d0):
 
 
 @njit(cache=True)
-def finish(lt, lv, meas, j, row, final, stopped, dt, rt, ry, a, b, lg):
+def finish(lt, lv, meas, codes, j, row, final, stopped, dt, rt, ry, a, b, lg):
     """Member ``row``'s measures from ladder row ``j`` at the end of its run (``final``:
     the norm at its last state; ``stopped``: it did not run to the end)."""
-    still = summarize(meas, row, final, stopped)
+    still = summarize(meas, codes, row, final, stopped)
     if not stopped:
-        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
 
 
 @njit(cache=True)
-def finish_with_map(lt, lv, S, meas, j, row, final, stopped, ng, pm, base_j, lowest, dt, rt,
+def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base_j, lowest, dt, rt,
                     ry, a, b, lg):  # fmt: skip
     """:func:`finish` for a member with one-step map sums ``S`` (:func:`map_estimate`,
     ``dt`` the time between the map's pairs; ``lowest`` a level below which ladder row
@@ -94,28 +97,29 @@ def finish_with_map(lt, lv, S, meas, j, row, final, stopped, ng, pm, base_j, low
     the envelope.  A member whose largest norms grow (:func:`grows`) gets the map only
     when the envelope does not find it growing (it may decay first, which the map would
     read), so its envelope is fitted first."""
-    still = summarize(meas, row, final, stopped)
+    still = summarize(meas, codes, row, final, stopped)
     if stopped:
         return
     out = meas[row]
     if grows(out[C_D2], out[C_D3], out[C_D4]):
-        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
-        if out[C_REASON] != R_NOT_DECAYING:
-            map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry, lowest)
-    elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, dt, rt, ry, lowest):
-        fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg)
+        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
+        if codes[row, I_REASON] != R_NOT_DECAYING:
+            map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, lowest)
+    elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry,
+                          lowest):  # fmt: skip
+        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
 
 
 @njit(cache=True)
-def fit_envelope(lt, lv, meas, j, row, still, dt, rt, ry, a, b, lg):
+def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg):
     """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
     ``still``: the run ended while it was decaying)."""
     n = records(lt, lv, j, rt, ry)
-    estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row])
+    estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row], codes[row])
 
 
 @njit(cache=True)
-def summarize(meas, row, final, stopped):
+def summarize(meas, codes, row, final, stopped):
     """Member ``row``'s columns other than the fit at the end of its run (``final``: the
     norm at its last state; ``stopped``: it did not run to the end; then the fit's
     columns say so).  Returns whether the measured norm was still decaying at the end."""
@@ -132,18 +136,19 @@ def summarize(meas, row, final, stopped):
     # whether the measured norm is still falling at the end
     still = (out[C_D2] >= STILL_DECAYING * out[C_D3]
              and out[C_D3] >= STILL_DECAYING * out[C_D4])  # fmt: skip
-    out[C_FLOOR_REACHED] = 0.0 if still else 1.0
+    code = codes[row]
+    code[I_FLOOR_REACHED] = 0 if still else 1
     if stopped:
         for c in (C_BETA, C_GAMMA, C_FIT_START, C_FIT_END, C_SHIFT):
             out[c] = math.nan
-        out[C_POINTS] = 0
-        out[C_KIND] = K_NONE
-        out[C_REASON] = R_STOPPED
+        code[I_POINTS] = 0
+        code[I_KIND] = K_NONE
+        code[I_REASON] = R_STOPPED
     return still
 
 
 @njit(cache=True)
-def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g, gn,
+def predict(R, alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b, lg, g, gn,
             rho_R=math.nan):  # fmt: skip
     """Member ``row``'s predicted rate: ``g_{k+1} = R g_k`` from ``g_0 = alpha`` over the
     steps up to its fit window's end, through ladder row ``j``, fitted over the measured
@@ -152,9 +157,9 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g
     size."""
     out = meas[row]
     out[C_BETA_PRED] = math.nan
-    if out[C_REASON] != R_FITTED:
+    if codes[row, I_REASON] != R_FITTED:
         return
-    if out[C_KIND] == K_MAP:  # the map fitted to g_{k+1} = R g_k is R itself
+    if codes[row, I_KIND] == K_MAP:  # the map fitted to g_{k+1} = R g_k is R itself
         rho = rho_R if rho_R == rho_R else spectral_radius_of(R)
         out[C_BETA_PRED] = -math.log(rho) / h
         return
@@ -183,5 +188,5 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, j, row, rt, ry, a, b, lg, g
             lt[j, lev] = k * h
             lv[j, lev] = nrm
     n = records(lt, lv, j, rt, ry)
-    out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, out[C_KIND], h, a, b, lg,
+    out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, codes[row, I_KIND], h, a, b, lg,
                              out[C_SHIFT])  # fmt: skip

@@ -20,11 +20,11 @@ from .record import (
     C_FIT_END,
     C_FIT_START,
     C_GAMMA,
-    C_KIND,
-    C_POINTS,
-    C_REASON,
     C_SHIFT,
     C_W0,
+    I_KIND,
+    I_POINTS,
+    I_REASON,
     K_MAP,
     R_FITTED,
 )
@@ -531,7 +531,8 @@ def _map_gamma(lt, lv, j, lo, top, beta, u):
 
 
 @njit(cache=True)
-def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry, lowest=0):
+def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry,
+                 lowest=0):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
@@ -579,9 +580,10 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, row, tau, rt, ry, lowest=0)
         out[C_GAMMA] = gamma
         out[C_FIT_START] = 0.0
         out[C_FIT_END] = t_end
-        out[C_POINTS] = pairs
-        out[C_KIND] = K_MAP
         out[C_SHIFT] = math.nan
-        out[C_REASON] = R_FITTED
+        code = codes[row]
+        code[I_POINTS] = pairs
+        code[I_KIND] = K_MAP
+        code[I_REASON] = R_FITTED
         return True
     return False

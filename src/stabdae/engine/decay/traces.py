@@ -11,12 +11,12 @@ from numba import njit
 from ..threads import run_chunks
 from .ladder import ladders, scratch
 from .member import begin, finish, observe, predict
-from .record import NCOLS
+from .record import Record
 
 
 # --------------------------------------------------------------------- stored traces
 @njit(nogil=True, cache=True)
-def _measure_rows(norms, times, meas, R, alphas, lo, hi):
+def _measure_rows(norms, times, meas, codes, R, alphas, lo, hi):
     lt, lv, base = ladders(1)
     rt, ry, a, b, lg = scratch()
     T = norms.shape[1]
@@ -25,7 +25,7 @@ def _measure_rows(norms, times, meas, R, alphas, lo, hi):
     g = np.empty(alphas.shape[1])
     gn = np.empty(alphas.shape[1])
     for r in range(lo, hi):
-        begin(lt, lv, base, meas, 0, r, norms[r, 0], norms[r, 0])
+        begin(lt, lv, base, meas, codes, 0, r, norms[r, 0], norms[r, 0])
         last = norms[r, 0]
         stopped = False
         for i in range(1, T):
@@ -36,14 +36,15 @@ def _measure_rows(norms, times, meas, R, alphas, lo, hi):
             w = min(4, int(5.0 * (times[i] - times[0]) / span)) if span > 0.0 else 4
             observe(lt, lv, base, meas, 0, r, times[i] - times[0], v, v, w)
             last = v
-        finish(lt, lv, meas, 0, r, last, stopped, dt, rt, ry, a, b, lg)
+        finish(lt, lv, meas, codes, 0, r, last, stopped, dt, rt, ry, a, b, lg)
         if R.shape[0] > 0:
-            predict(R, alphas[r], T - 1, dt, lt, lv, base, meas, 0, r, rt, ry, a, b, lg,
+            predict(R, alphas[r], T - 1, dt, lt, lv, base, meas, codes, 0, r, rt, ry, a, b, lg,
                     g, gn)  # fmt: skip
 
 
 def measure_traces(norms, times, R=None, alpha0=None):
-    """The measures of :data:`COLUMNS` for stored traces, each sample taken as a step.
+    """The measurement record (:data:`COLUMNS`) of stored traces, each sample taken as a
+    step.
 
     Parameters
     ----------
@@ -57,7 +58,8 @@ def measure_traces(norms, times, R=None, alpha0=None):
 
     Returns
     -------
-    array (members, len(COLUMNS))
+    Record
+        ``record["beta"]`` etc.: a column by name, one row per member.
     """
     norms = np.ascontiguousarray(np.atleast_2d(norms), dtype=np.float64)
     times = np.ascontiguousarray(times, dtype=np.float64)
@@ -65,6 +67,6 @@ def measure_traces(norms, times, R=None, alpha0=None):
     R = np.zeros((0, 0)) if R is None else np.ascontiguousarray(R, dtype=np.float64)
     alphas = (np.zeros((M, 1)) if alpha0 is None
               else np.ascontiguousarray(np.atleast_2d(alpha0), dtype=np.float64))  # fmt: skip
-    meas = np.empty((M, NCOLS))
-    run_chunks(lambda lo, hi: _measure_rows(norms, times, meas, R, alphas, lo, hi), M)
-    return meas
+    out = Record.empty(M)
+    run_chunks(lambda lo, hi: _measure_rows(norms, times, *out, R, alphas, lo, hi), M)
+    return out

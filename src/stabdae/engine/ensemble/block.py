@@ -56,7 +56,7 @@ import numpy as np
 from numba import njit
 
 from ..._codes import Status
-from ..cache import kernel_key, keyed_cache, memo, tag
+from ..cache import Spec, keyed_cache, memo, tag
 from ..decay import (
     MAP_MAX_NG,
     MAP_SHIFT,
@@ -116,13 +116,10 @@ def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the kinds of
     the scheme's coefficients, block, the shape of the law's matrix and whether the decay
     measurement pools the constraints, :func:`pooled_constraints`)."""
-    pattern = tableau_pattern(scheme)
-    shape = bound.matrix.shape
-    n_params = len(model.param_names)
-    pooled = pooled_constraints(model, bound.law)
-    return memo(model, ("ensemble", bound.code, bound.fn, pattern, block, shape, pooled),
-                lambda: build_block_kernel(kernels_for(model, bound), pattern, block, n_params,
-                                         shape, pooled))  # fmt: skip
+    spec = Spec("block", law=bound.code, law_fn=bound.fn, pattern=tableau_pattern(scheme),
+                block=block, n_params=len(model.param_names), law_shape=bound.matrix.shape,
+                pooled=pooled_constraints(model, bound.law))  # fmt: skip
+    return memo(model, spec, lambda: build_block_kernel(kernels_for(model, bound), spec))
 
 
 # The block's bookkeeping at checks and stops: sizes from the arrays, so that these are
@@ -189,14 +186,16 @@ def block_failed(X, code):
     return bad
 
 
-def build_block_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_shape=(1, 1),
-                     pooled: int = -1):  # fmt: skip
-    """The block-lockstep ensemble kernel for the kernels ``K``, an explicit scheme whose
-    coefficients are of the kinds ``pattern`` (:func:`tableau_pattern`), blocks of
-    ``block`` members, ``n_params`` parameters, a law matrix of shape ``law_shape`` and
-    the decay measurement's one-step map pooled over ``pooled`` holonomic constraints
-    (−1: the full map; :func:`.decay.map_width`), all fixed at compile time; the
-    scheme's coefficients, the parameters and the law's numbers are run-time arrays."""
+def build_block_kernel(K, spec: Spec):
+    """The block-lockstep ensemble kernel for the kernels ``K`` and the compile spec
+    ``spec``: an explicit scheme whose coefficients are of the kinds ``spec.pattern``
+    (:func:`tableau_pattern`), blocks of ``spec.block`` members, ``spec.n_params``
+    parameters, a law matrix of shape ``spec.law_shape`` and the decay measurement's
+    one-step map pooled over ``spec.pooled`` holonomic constraints (−1: the full map;
+    :func:`.decay.map_width`), all fixed at compile time; the scheme's coefficients, the
+    parameters and the law's numbers are run-time arrays (:mod:`.groups`)."""
+    pattern, block, n_params = spec.pattern, spec.block, spec.n_params
+    law_shape, pooled = spec.law_shape, spec.pooled
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
     N2, ng = 2 * K.n, K.ng
@@ -235,25 +234,30 @@ def build_block_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_sh
             dnrm[j] = d
 
     @njit(nogil=True, error_model="numpy")
-    def block_kernel(x0s, alpha0s, t0, tau, nsteps, save_every, p, law_mat, law_scal, tab_a,
-                   tab_b, tab_c, threshold, g_ref, R, stride, trace_row, out_norm, meas,
-                   x_final, status, fail_step, e0, e1, g_out, b_lo, b_hi):  # fmt: skip
-        """Integrate the rows of ``x0s`` in blocks ``b_lo … b_hi − 1``; outputs as in
+    def block_kernel(inputs, grid, tableau, measure, out, b_lo, b_hi):
+        """Integrate the members of ``inputs`` (:mod:`.groups`) on ``grid`` with the
+        scheme of ``tableau`` in blocks ``b_lo … b_hi − 1``; outputs as in
         :func:`stabdae.ensemble`.  Member ``i``'s stored samples go to row
-        ``trace_row[i]`` of ``out_norm`` (none when −1); its decay measures
-        (:mod:`.decay`, from ``‖g‖`` at every step) to row ``i`` of ``meas``, with the
-        linear prediction ``g_{k+1} = R g_k`` from ``alpha0s[i]`` when ``R`` is not
-        empty (``R`` advances ``stride`` steps: the decay is measured at every
-        ``stride``-th state, :func:`stabdae._ensemble.measure_stride`).  The decay is
-        measured on
+        ``measure.trace_row[i]`` of ``out.norms`` (none when −1); its decay measures
+        (:mod:`.decay`, from ``‖g‖`` at every measured step) to row ``i`` of ``out.meas``
+        and ``out.codes``, with the linear prediction ``g_{k+1} = R g_k`` from
+        ``alpha0[i]`` when ``measure.R`` is not empty (``R`` advances ``measure.stride``
+        steps: the decay is measured at every ``stride``-th state,
+        :func:`stabdae._ensemble.measure_stride`).  The decay is measured on
         ``‖g_k − g_ref[k]‖∞``, ``g_ref`` the residual of a reference trajectory at every
-        step (none when it has no rows: ``‖g_k‖∞``).  When ``g_out`` has rows, the
+        step (none when it has no rows: ``‖g_k‖∞``).  When ``out.g_out`` has rows, the
         residual of the first member at every step goes to its rows (the reference
         trajectory is such a run of one member: the same step, compiled once).
-        Every output row of the blocks is written here (``out_norm`` NaN after a stop,
+        Every output row of the blocks is written here (``norms`` NaN after a stop,
         ``status`` 0 and ``fail_step`` −1 for a member that runs to the end), so the
         driver allocates them empty and the pages are first touched by the threads
         that fill them.  Releases the GIL (run by :func:`.threads.run_chunks`)."""
+        x0s, alpha0s, p, law_mat, law_scal = inputs
+        t0, tau, nsteps, save_every = grid
+        tab_a, tab_b, tab_c = tableau
+        threshold, g_ref, R, stride, trace_row = measure
+        out_norm, meas, mcodes, x_final = out.norms, out.meas, out.codes, out.x_final
+        status, fail_step, e0, e1, g_out = out.status, out.fail_step, out.e0, out.e1, out.g_out
         M = x0s.shape[0]
         nsave = out_norm.shape[1]
         # the small run-time inputs on the stack (copy_inputs: no aliasing)
@@ -350,7 +354,7 @@ def build_block_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_sh
                 nrm = nrm_b[j]
                 if trace_row[lo + j] >= 0:
                     out_norm[trace_row[lo + j], 0] = nrm
-                begin(lt, lv, base, meas, j, lo + j, nrm, dn_b[j])
+                begin(lt, lv, base, meas, mcodes, j, lo + j, nrm, dn_b[j])
                 map_begin(S_map, j)
                 active[j] = True
                 alive += 1
@@ -478,14 +482,15 @@ def build_block_kernel(K, pattern, block: int = BLOCK, n_params: int = 1, law_sh
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
                 # no level below the lowest bin measured or the final state's was visited
                 lowest = min(low[j] << MAP_SHIFT, ladder_level(dn_b[j], base[j]))
-                finish_with_map(lt, lv, S_map, meas, j, lo + j, final, not active[j], ng,
-                                pooled, base[j], lowest, stride * tau, rt, ry, fa, fb,
+                finish_with_map(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
+                                ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb,
                                 lg)  # fmt: skip
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
-                            meas, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p, rho_R)  # fmt: skip
+                            meas, mcodes, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p,
+                            rho_R)  # fmt: skip
 
-    key = kernel_key(K.key, "block", pattern, block, n_params, law_shape, pooled)
+    key = spec.key(K.key)
     tag(key, block_norms, member_step, pairs_full,
         *((bin_flush, end_flush) if FULL and pooled < 0 else ()))  # (closures only)
     return keyed_cache(block_kernel, key)

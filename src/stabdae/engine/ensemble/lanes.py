@@ -13,10 +13,10 @@ import math
 import numpy as np
 from numba import njit
 
-from ..cache import kernel_key, keyed_cache, memo, tag
+from ..cache import Spec, keyed_cache, memo, tag
 from ..decay import begin, finish, ladders, observe, predict, scratch
 from ..rhs import kernels_for
-from ..rk.adaptive import _label, _pattern, attempt_for
+from ..rk.adaptive import _pattern, attempt_for
 from ..rk.control import _DIVERGED, _f_eval, _first_step, _next_step, _settle
 
 # ------------------------------------------------------------------- lanes in lockstep
@@ -27,42 +27,41 @@ LANES = 8
 def adaptive_block_for(model, bound, pair, lanes: int = LANES):
     """The compiled block adaptive ensemble kernel (memoized per law kind, the pair's
     stage counts and norm, the number of lanes, the shape of the law's matrix)."""
-    s, s_e = pair.scheme.stages, pair.error.shape[1]
-    shape = bound.matrix.shape
-    n_params = len(model.param_names)
-    pattern = _pattern(pair)
-    return memo(model, ("adaptive-block", bound.code, bound.fn, s, s_e, pair.combined, pattern,
-                        lanes, shape),
-                lambda: _build_adaptive_block(kernels_for(model, bound), s, s_e,
-                                              pair.combined, pattern, lanes, n_params,
-                                              shape))  # fmt: skip
+    spec = Spec("lanes", law=bound.code, law_fn=bound.fn, pattern=_pattern(pair),
+                stages=(pair.scheme.stages, pair.error.shape[1]), combined=pair.combined,
+                block=lanes, n_params=len(model.param_names), law_shape=bound.matrix.shape)
+    return memo(model, spec, lambda: _build_adaptive_block(kernels_for(model, bound), spec))
 
 
-def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B: int,
-                          n_params: int, law_shape):  # fmt: skip
+def _build_adaptive_block(K, spec: Spec):
     from ..workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 
     rhs, residual, energy = K.rhs, K.residual, K.energy
     make_workspace, stack_workspace = K.make_workspace, K.stack_workspace
     N2, ng = 2 * K.n, K.ng
-    NP = max(n_params, 1)
-    LR, LC = law_shape
-    label = _label(s, s_e, combined, pattern)
+    (s, s_e), combined, pattern, B = spec.stages, spec.combined, spec.pattern, spec.block
+    NP = max(spec.n_params, 1)
+    LR, LC = spec.law_shape
     attempt = attempt_for(rhs, s, s_e, combined, pattern, N2, ng)
 
     f_eval = _f_eval(rhs)
     first_step = _first_step(f_eval, N2)
 
     @njit(nogil=True, error_model="numpy")
-    def block_kernel(x0, alpha0s, t0, save_times, p, law_mat, law_scal, tab_a, tab_b, tab_e,
-                     tab_c, q, rtol, atol, h0, max_steps, divergence, R, h_pred, trace_row,
-                     norms, meas, x_final, status, fail_step, e0, e1, steps, nfev, lo,
-                     hi):  # fmt: skip
-        """Members ``lo … hi − 1`` on ``B`` lanes: each lane runs one member with its own
-        step size, error norm and accept/reject; the attempted steps of all lanes are one
-        loop over the lanes (vectorized), the step-size control, samples and decay
-        measurement a scalar pass after it; a lane whose member has finished (or
-        stopped) takes the next waiting member.  Outputs as the per-member kernel's."""
+    def block_kernel(inputs, grid, tableau, measure, out, lo, hi):
+        """Members ``lo … hi − 1`` of ``inputs`` (:mod:`.groups`) on ``B`` lanes: each
+        lane runs one member with its own step size, error norm and accept/reject; the
+        attempted steps of all lanes are one loop over the lanes (vectorized), the
+        step-size control, samples and decay measurement a scalar pass after it; a lane
+        whose member has finished (or stopped) takes the next waiting member.  Outputs as
+        the block kernel's (:mod:`.block`), with ``out.steps`` and ``out.nfev``."""
+        x0, alpha0s, p, law_mat, law_scal = inputs
+        t0, save_times, h0, rtol, atol, max_steps = grid
+        tab_a, tab_b, tab_e, tab_c, q = tableau
+        divergence, R, h_pred, trace_row = measure
+        norms, meas, mcodes, x_final = out.norms, out.meas, out.codes, out.x_final
+        status, fail_step, e0, e1 = out.status, out.fail_step, out.e0, out.e1
+        steps, nfev = out.steps, out.nfev
         if hi <= lo:
             return
         expo = 1.0 / (q + 1)
@@ -179,11 +178,11 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
                         final = 0.0
                         for l in range(ng):
                             final = max(final, abs(g_h[l]))
-                    finish(lt, lv, meas, lane, i, final, st != 0,
+                    finish(lt, lv, meas, mcodes, lane, i, final, st != 0,
                            span / max(acc_n[lane], 1), rt, ry, fa, fb, lg)  # fmt: skip
                     if R.shape[0] > 0:
                         predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt, lv,
-                                base, meas, lane, i, rt, ry, fa, fb, lg, g_p,
+                                base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
                                 gn_p)  # fmt: skip
                     mem[lane] = -1
                     alive -= 1
@@ -198,15 +197,16 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
                     if status[i] != 0:  # not placed: keep it out
                         for l in range(N2):
                             x_final[i, l] = x_h[l]
-                        begin(lt, lv, base, meas, lane, i, math.nan, math.nan)
-                        finish(lt, lv, meas, lane, i, math.nan, True, 1.0, rt, ry, fa, fb, lg)
+                        begin(lt, lv, base, meas, mcodes, lane, i, math.nan, math.nan)
+                        finish(lt, lv, meas, mcodes, lane, i, math.nan, True, 1.0, rt, ry, fa,
+                               fb, lg)  # fmt: skip
                         continue
                     e0[i] = energy(t0, x_h, p, ws_h)
                     residual(t0, x_h, p, ws_h, g_h)
                     r0 = 0.0
                     for l in range(ng):
                         r0 = max(r0, abs(g_h[l]))
-                    begin(lt, lv, base, meas, lane, i, r0, r0)
+                    begin(lt, lv, base, meas, mcodes, lane, i, r0, r0)
                     acc_n[lane] = rej_n[lane] = fev_n[lane] = 0
                     # sample 0 (as the single loop's save: ‖g‖ at t0, checked)
                     r = r0 if math.isfinite(r0) else math.inf
@@ -229,11 +229,11 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
                         steps[i] = 0
                         nfev[i] = fev_n[lane]
                         fail_step[i] = 0
-                        finish(lt, lv, meas, lane, i, math.nan, True, span, rt, ry, fa, fb,
+                        finish(lt, lv, meas, mcodes, lane, i, math.nan, True, span, rt, ry, fa, fb,
                                lg)  # fmt: skip
                         if R.shape[0] > 0:
                             predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt,
-                                    lv, base, meas, lane, i, rt, ry, fa, fb, lg, g_p,
+                                    lv, base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
                                     gn_p)  # fmt: skip
                         continue
                     mem[lane] = i
@@ -280,6 +280,7 @@ def _build_adaptive_block(K, s: int, s_e: int, combined: bool, pattern: tuple, B
                 E[lane] = e
                 RN[lane] = r
 
-    tag(kernel_key(K.key, f"adaptive-block-{label}-{B}"), attempt, f_eval, first_step)
-    keyed_cache(block_kernel, kernel_key(K.key, f"adaptive-block-{label}-{B}-{NP}-{LR}x{LC}"))
+    key = spec.key(K.key)
+    tag(key, attempt, f_eval, first_step)
+    keyed_cache(block_kernel, key)
     return block_kernel

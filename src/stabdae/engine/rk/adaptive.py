@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..cache import kernel_key, keyed_cache, memo, tag
+from ..cache import Spec, fingerprint, keyed_cache, memo, tag
 from ..rhs import kernels_for
 from .control import _DIVERGED, _combined_norm, _f_eval, _first_step, _next_step, _settle
 from .steps import UNROLL_MAX_TERMS, sample_writer
@@ -28,8 +28,8 @@ __all__ = ["adaptive_for", "attempt_for"]
 
 def adaptive_for(model, bound, multiplier: str = "ldl"):
     """The compiled adaptive loop for ``model`` under the law's kind (memoized)."""
-    return memo(model, ("adaptive", bound.code, bound.fn, multiplier),
-                lambda: _build_adaptive(kernels_for(model, bound, multiplier)))
+    spec = Spec("adaptive", law=bound.code, law_fn=bound.fn, multiplier=multiplier)
+    return memo(model, spec, lambda: _build_adaptive(kernels_for(model, bound, multiplier), spec))
 
 
 def _adaptive_loop(K, save, label: str):
@@ -160,11 +160,12 @@ def _adaptive_loop(K, save, label: str):
         counts[0], counts[1], counts[2] = accepted, rejected, nfev
         return 0, nsave + 1
 
-    tag(kernel_key(K.key, f"adaptive-loop-{label}"), f_eval, first_step, run)
+    # (the loop is part of other kernels: its names need only differ per model and label)
+    tag(K.key and fingerprint(K.key, "adaptive-loop", label), f_eval, first_step, run)
     return run
 
 
-def _build_adaptive(K):
+def _build_adaptive(K, spec: Spec):
     make_workspace = K.make_workspace
     write = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
@@ -190,7 +191,7 @@ def _build_adaptive(K):
                    combined, q, rtol, atol, h0, max_steps, sweeps, tol, ws, k, xs, xnew, g,
                    (out_x, out_g, out_e), counts)  # fmt: skip
 
-    keyed_cache(adaptive_kernel, kernel_key(K.key, "adaptive-dopri5"))
+    keyed_cache(adaptive_kernel, spec.key(K.key))
     return adaptive_kernel
 
 

@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from ..._codes import Status
-from ..cache import kernel_key, keyed_cache, memo
+from ..cache import Spec, keyed_cache, memo
 from ..fma import fma
 from ..rhs import kernels_for
 from ..source import exec_source
@@ -48,8 +48,8 @@ Stepper = namedtuple("Stepper", "step integrate")
 def stepper_for(model, bound, multiplier: str = "ldl") -> Stepper:
     """The compiled RK step and single-trajectory loop for ``model`` under the law's kind
     (memoized on the model)."""
-    return memo(model, ("stepper", bound.code, bound.fn, multiplier),
-                lambda: _build_stepper(kernels_for(model, bound, multiplier)))
+    spec = Spec("stepper", law=bound.code, law_fn=bound.fn, multiplier=multiplier)
+    return memo(model, spec, lambda: _build_stepper(kernels_for(model, bound, multiplier), spec))
 
 
 def integrator_for(model, bound, multiplier: str = "ldl"):
@@ -75,7 +75,7 @@ def sample_writer(K):
     return save
 
 
-def _build_stepper(K):
+def _build_stepper(K, spec: Spec):
     rhs, make_workspace, project = K.rhs, K.make_workspace, K.project
     save = sample_writer(K)
     N2, ng = 2 * K.n, K.ng
@@ -142,19 +142,20 @@ def _build_stepper(K):
                 j += 1
         return 0, nsteps
 
-    keyed_cache(step, kernel_key(K.key, "step"))
-    keyed_cache(integrate_kernel, kernel_key(K.key, "integrate"))
+    keyed_cache(step, spec.key(K.key, "step"))
+    keyed_cache(integrate_kernel, spec.key(K.key, "integrate"))
     return Stepper(step, integrate_kernel)
 
 
 def multipliers_for(model, bound, multiplier: str = "ldl"):
     """``kernel(times, xs, p, law_mat, law_scal, out_lam, out_acc)``: the multipliers λ of
     (3.11) and the accelerations v̇ at stored states (memoized on the model)."""
-    return memo(model, ("multipliers", bound.code, bound.fn, multiplier),
-                lambda: _build_multipliers(kernels_for(model, bound, multiplier)))  # fmt: skip
+    spec = Spec("multipliers", law=bound.code, law_fn=bound.fn, multiplier=multiplier)
+    return memo(model, spec,
+                lambda: _build_multipliers(kernels_for(model, bound, multiplier), spec))
 
 
-def _build_multipliers(K):
+def _build_multipliers(K, spec: Spec):
     rhs, make_workspace = K.rhs, K.make_workspace
     n, r, N2 = K.n, K.m + K.k, 2 * K.n
 
@@ -179,7 +180,7 @@ def _build_multipliers(K):
             for i in range(n):
                 out_acc[j, i] = xdot[n + i]
 
-    return keyed_cache(multipliers, kernel_key(K.key, "multipliers"))
+    return keyed_cache(multipliers, spec.key(K.key))
 
 #: the member step's sums over the state are written out per component while the state's
 #: size times the stages is at most this (a loop left in the step keeps the member loop
