@@ -36,7 +36,7 @@ def test_adaptive_members_control_their_own_steps(pair):
 
 
 @pytest.mark.parametrize("pair", ["dopri5", "dop853"])
-def test_adaptive_lanes_refill_and_stay_bit_identical(pair):
+def test_lanes_attempt_and_adaptive_loop_agree_bit_for_bit(pair):
     """Members of very different step counts (at rest to spinning at 100 rad/s) on three
     lanes, five or so members per work item (so lanes are refilled): a lane whose member
     has ended takes the next waiting one, and every member is still the single adaptive

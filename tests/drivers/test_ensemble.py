@@ -22,7 +22,7 @@ from stabdae.engine.ensemble.block import CHECKPOINT
 from stabdae.engine.fma import HOST_FMA
 
 
-def test_members_equal_single_integrations_bit_for_bit():
+def test_member_step_and_looped_step_agree_bit_for_bit():
     model = load_scene("double_pendulum")
     law = stabdae.baumgarte(20.0, 1.0)
     ds = stabdae.ensemble(model, law, "heun", 1e-3, 0.5, members=5, seed=2, save_dt=0.05)
@@ -163,7 +163,7 @@ def _scheme(spec):
 
 
 @pytest.mark.parametrize("spec", ["euler", "midpoint", "rk4", "dop853", (0.3, 0.0), (0.25, 2.0)])
-def test_every_tableau_pattern_equals_single_integrations(spec):
+def test_member_step_and_looped_step_agree_for_every_tableau_pattern(spec):
     """The ensemble kernel is compiled per pattern of zero / one / other coefficients and
     writes the stages out; its numbers are still those of ``integrate`` bit for bit
     (σ = 0 has a zero weight, σ = 2 two general ones, DOP853 twelve stages and zeros
@@ -180,7 +180,7 @@ def test_every_tableau_pattern_equals_single_integrations(spec):
 
 
 @pytest.mark.parametrize("spec", ["rk4", "dopri5"])
-def test_time_dependent_model_stage_times_equal_single_integrations(spec):
+def test_member_step_and_looped_step_agree_on_stage_times(spec):
     """On time-dependent constraints (the pendulum of prescribed length, the car axis) the
     stage times t + c·τ matter: the ensemble kernel's generated step gives the numbers of
     ``integrate`` bit for bit.  The stage times are formed alike for every pattern of

@@ -92,7 +92,7 @@ def test_pivot_rule_is_relative_to_the_matrix_scale(scale):
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 4, 7, 8])
-def test_written_out_routines_give_the_loops_numbers_bit_for_bit(n):
+def test_written_out_and_looped_ldl_agree_bit_for_bit(n):
     """The straight-line factor and solves that a dense right-hand side uses for its sizes
     (so that the ensemble kernel's member loop around them vectorizes) do the loops'
     operations in the loops' order: the same bits, the same failing pivot, the same

@@ -1,8 +1,8 @@
 """The fixed-step explicit Runge–Kutta step, twice, side by side: looped and generated.
 
 They must give the same bits for the same state (the tests
-``test_members_equal_single_integrations_bit_for_bit`` and
-``test_every_tableau_pattern_equals_single_integrations`` pair them):
+``test_member_step_and_looped_step_agree_bit_for_bit`` and
+``test_member_step_and_looped_step_agree_for_every_tableau_pattern`` pair them):
 
 * the looped step (``step`` of :func:`stepper_for`) applies a tableau ``(A, b, c)`` given as
   run-time arrays (a new scheme never recompiles); ``integrate_kernel`` runs it over a
