@@ -148,3 +148,34 @@ def test_ensemble_kernel_is_looked_up_once_per_run(monkeypatch):
     stabdae.ensemble(load_scene("pendulum"), stabdae.baumgarte(10.0, 1.0), "midpoint", 1e-3,
                      0.05, members=8, seed=1)  # fmt: skip
     assert len(calls) == 1
+
+
+# ---------------------------------------------------------------- declared buffers
+_ALLOCATORS = ("stack1", "stack2", "stack_int1", "np.empty", "np.zeros", "np.full",
+               "ladders", "scratch", "map_buffers", "make_workspace", "K_make_workspace",
+               "stack_workspace")  # fmt: skip
+
+
+def _allocations(module, factory: str) -> dict:
+    """``{target: allocation}`` of every buffer the kernel built by ``factory`` allocates
+    (its closures included)."""
+    tree = ast.parse(inspect.getsource(module))
+    fn = next(n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) and n.name == factory)
+    out = {}
+    for node in ast.walk(fn):
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) \
+                and ast.unparse(node.value.func) in _ALLOCATORS:  # fmt: skip
+            target = ast.unparse(node.targets[0]).strip("()")
+            call = ast.unparse(node.value)
+            assert out.get(target, call) == call, (target, call)
+            out[target] = call
+    return out
+
+
+@pytest.mark.parametrize("module, factory", [(block, "build_block_kernel"),
+                                             (lanes, "_build_adaptive_block")])  # fmt: skip
+def test_kernel_buffers_are_the_declared_ones(module, factory):
+    """Each ensemble kernel allocates exactly the buffers its ``BUFFERS`` declares, each
+    as declared: a buffer added, removed or resized without its declaration fails."""
+    got = _allocations(module, factory)
+    assert got == {name: alloc for name, (alloc, _) in module.BUFFERS.items()}

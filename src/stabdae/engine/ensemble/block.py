@@ -112,6 +112,57 @@ def pooled_constraints(model, law) -> int:
     return m if ok else -1
 
 
+#: Every buffer of the block kernel, declared once: its allocation (sizes: ``N2`` = 2n
+#: state components, ``ng`` residual components, ``B`` slots, ``S_`` stages, ``NP``
+#: parameters, ``LR × LC`` the law's matrix, ``NA`` rows of a bin visit's sums) and what
+#: it holds.  ``stack*`` buffers live on the thread's stack, the others on the heap (once
+#: per call).  A test checks the kernel allocates exactly these.
+BUFFERS = {
+    # the small run-time inputs, copied to the stack so that nothing aliases them
+    "p_s": ("stack1(NP)", "the parameters"),
+    "lm": ("stack2(LR, LC)", "the law's matrix"),
+    "ls": ("stack1(1)", "the law's scalar"),
+    "ta": ("stack2(S_, S_)", "the scheme's A"),
+    "tb": ("stack1(S_)", "the scheme's b"),
+    "tc": ("stack1(S_)", "the scheme's c"),
+    # the block
+    "X": ("stack2(N2, B)", "the states, updated in place (slot j: column j)"),
+    "Xc": ("stack2(N2, B)", "X at the last check it passed, to roll back to"),
+    "code": ("stack_int1(B)", "each slot's status since that check (ORed)"),
+    "active": ("stack_int1(B)", "1 for a slot whose member (not padding) still runs"),
+    # one member at a time, outside the member loop
+    "ws_h": ("K_make_workspace()", "the right-hand side's workspace"),
+    "xs_h": ("np.empty(N2)", "one member's state (energy, a stop's last state)"),
+    "nrm_b": ("np.empty(B)", "‖g‖ of every slot at a stored sample"),
+    "dn_b": ("np.empty(B)", "... its distance from the reference's residual"),
+    "g_p": ("np.empty(alpha0s.shape[1])", "the linear prediction's g"),
+    "gn_p": ("np.empty(alpha0s.shape[1])", "... and its next g"),
+    # the decay measurement (:mod:`..decay`)
+    "gs": ("stack1(B)", "‖g‖ at a measured state"),
+    "ds": ("stack1(B)", "... its distance from the reference's"),
+    "gr": ("stack1(ng)", "the reference's residual at the current step"),
+    "Gb": ("stack2(ng, B)", "the slots' residuals at a stored sample"),
+    "lt, lv, base": ("ladders(B)", "each slot's ladder: times, norms, offset"),
+    "rt, ry, fa, fb, lg": ("scratch()", "the fits' scratch"),
+    "S_map": ("map_buffers(B, ng, pooled)", "the one-step map's sums per slot and bin"),
+    "Dv": ("stack2(ng, B)", "each slot's g (then g − g_ref) at a measured state"),
+    "P": ("stack2(ng, B)", "... at the measured state before"),
+    "Am": ("stack2(NA, B)", "the running sums of the current bin visit"),
+    "base_s": ("stack_int1(B)", "each slot's ladder offset"),
+    "low": ("stack_int1(B)", "the lowest map bin reached"),
+    "nlev": ("stack_int1(B)", "the level at this state"),
+    "wmax": ("stack1(B)", "the largest ‖g‖ of the fifth so far"),
+    "dmax": ("stack1(B)", "... of the measured norm"),
+    # inside the member loop: per slot, on the stack (LLVM keeps them in registers)
+    "ws": ("stack_workspace()", "the right-hand side's workspace"),
+    "xs": ("stack1(N2)", "a stage's state (block_norms: the slot's state)"),
+    "gj": ("stack1(ng)", "block_norms: the slot's residual"),
+    "xk": ("stack1(N2)", "the slot's state before the step"),
+    "xn": ("stack1(N2)", "... after it"),
+    "gv": ("stack1(ng)", "the residual the step's first stage evaluated"),
+}
+
+
 def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the kinds of
     the scheme's coefficients, block, the shape of the law's matrix and whether the decay

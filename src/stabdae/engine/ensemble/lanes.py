@@ -24,6 +24,56 @@ from ..rk.control import _DIVERGED, _f_eval, _first_step, _next_step, _settle
 LANES = 8
 
 
+#: Every buffer of the lanes kernel, declared once (as :data:`.block.BUFFERS`; ``s`` and
+#: ``s_e`` the pair's stage counts); a test checks the kernel allocates exactly these.
+BUFFERS = {
+    "p_s": ("stack1(NP)", "the parameters"),
+    "lm": ("stack2(LR, LC)", "the law's matrix"),
+    "ls": ("stack1(1)", "the law's scalar"),
+    "ta": ("stack2(s, s)", "the pair's A"),
+    "tb": ("stack1(s)", "the pair's b"),
+    "tc": ("stack1(s)", "the pair's c"),
+    "te": ("stack2(2, s_e)", "the error estimate's weights"),
+    # per lane
+    "X": ("stack2(N2, B)", "the state"),
+    "K0": ("stack2(N2, B)", "the first stage (FSAL: the last accepted step's last)"),
+    "XN": ("stack2(N2, B)", "the attempt's new state"),
+    "KL": ("stack2(N2, B)", "... and its last stage"),
+    "T": ("stack1(B)", "the time"),
+    "HH": ("stack1(B)", "the attempted step (0: none yet)"),
+    "E": ("stack1(B)", "the attempt's error norm"),
+    "RN": ("stack1(B)", "the attempt's ‖g‖ at the new state"),
+    "GOOD": ("stack_int1(B)", "whether the attempt's right-hand sides succeeded"),
+    "NEV": ("stack_int1(B)", "the attempt's evaluations"),
+    "H": ("np.empty(B)", "the next step the control proposes"),
+    "hit": ("np.zeros(B, dtype=np.bool_)", "the attempt ends on a sample time"),
+    "after": ("np.zeros(B, dtype=np.bool_)", "the last step was rejected (no growth)"),
+    "jj": ("np.zeros(B, dtype=np.int64)", "the next sample"),
+    "mem": ("np.full(B, -1, dtype=np.int64)", "the lane's member (−1: none)"),
+    "acc_n": ("np.zeros(B, dtype=np.int64)", "accepted steps"),
+    "rej_n": ("np.zeros(B, dtype=np.int64)", "rejected steps"),
+    "fev_n": ("np.zeros(B, dtype=np.int64)", "right-hand-side evaluations"),
+    # one member at a time, in the scalar pass
+    "ws_h": ("make_workspace()", "the right-hand side's workspace"),
+    "x_h": ("np.empty(N2)", "a member's state"),
+    "k0_h": ("np.empty(N2)", "its first stage"),
+    "k1_h": ("np.empty(N2)", "the first step's trial stage"),
+    "xs_h": ("np.empty(N2)", "the first step's trial state"),
+    "g_h": ("np.empty(ng)", "a member's residual"),
+    "lt, lv, base": ("ladders(B)", "each lane's ladder"),
+    "rt, ry, fa, fb, lg": ("scratch()", "the fits' scratch"),
+    "g_p": ("np.empty(alpha0s.shape[1])", "the linear prediction's g"),
+    "gn_p": ("np.empty(alpha0s.shape[1])", "... and its next g"),
+    # inside the lane loop: per lane, on the stack
+    "ws": ("stack_workspace()", "the attempt's workspace"),
+    "x": ("stack1(N2)", "the lane's state"),
+    "k0": ("stack1(N2)", "its first stage"),
+    "xs": ("stack1(N2)", "a stage's state"),
+    "xn": ("stack1(N2)", "the attempt's new state"),
+    "kl": ("stack1(N2)", "... and its last stage"),
+}
+
+
 def adaptive_block_for(model, bound, pair, lanes: int = LANES):
     """The compiled block adaptive ensemble kernel (memoized per law kind, the pair's
     stage counts and norm, the number of lanes, the shape of the law's matrix)."""
