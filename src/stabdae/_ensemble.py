@@ -329,8 +329,9 @@ class _Fixed:
     def integrate(self, run, x0, alpha0, status, g_ref) -> Outputs:
         """The kernel over chunks of blocks on threads."""
         M = x0.shape[0]
+        g = self.grid
         out = outputs(M, x0.shape[1], run.model.n_residual, run.traced.size,
-                      self.times(run.t0).size, run.rdtype)  # fmt: skip
+                      g.nsteps // g.save_every + 1, run.rdtype)  # fmt: skip
         R_stride = (np.linalg.matrix_power(run.R, self.stride) if run.R.size else run.R)
         measure = FixedMeasurement.of(run.divergence, g_ref, R_stride, self.stride,
                                       run.trace_row)  # fmt: skip
@@ -471,12 +472,12 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
         raise TypeError(f"{who}: states must be True or False, got {states!r}")
     bound = check.bound_law(law, model, who)
     if adaptive:
-        R, h_pred = _prediction(law, model, scheme, float(t_end) - t0, adaptive=True)
+        R, h_pred = _prediction(law, model, span=float(t_end) - t0)
         mode = _Lanes(AdaptiveGrid.of(t0, save_times, tau, rtol, atol, MAX_STEPS),
                       PairTableau.of(pair), adaptive_block_for(model, bound, pair, block),
                       pair.name)  # fmt: skip
     else:
-        R, h_pred = _prediction(law, model, scheme, tau)
+        R, h_pred = _prediction(law, model, scheme, tau=tau)
         mode = _Fixed(FixedGrid.of(t0, tau, nsteps, save_every), Tableau.of(scheme),
                       ensemble_kernel_for(model, bound, scheme, block),
                       measure_stride(R))  # fmt: skip
@@ -558,17 +559,17 @@ def _trace_rows(traces, members: int, who: str):
     return trace_row, traced
 
 
-def _prediction(law, model, scheme, tau_or_span, adaptive=False):
+def _prediction(law, model, scheme=None, tau=None, span=None):
     """The one-step propagator of each member's linear prediction and its step: ``R(τÃ)``
-    for fixed steps of ``tau``, ``e^{Ãh}`` over ``PREDICTION_STEPS`` steps of a run over
-    ``span`` for adaptive ones; an empty matrix for laws that are not constant."""
+    for fixed steps of ``tau`` with ``scheme``, or ``e^{Ãh}`` over ``PREDICTION_STEPS``
+    steps of an adaptive run over ``span``; an empty matrix for laws that are not
+    constant."""
     if not law.is_constant:
         return np.zeros((0, 0)), 1.0
     A = np.asarray(law.A_tilde(model), dtype=float)
-    if adaptive:
-        h = tau_or_span / PREDICTION_STEPS
+    if span is not None:
+        h = span / PREDICTION_STEPS
         return np.ascontiguousarray(theory._expm(A * h)), h
-    tau = tau_or_span
     return np.ascontiguousarray(theory.step_matrix(A, scheme, tau)), tau
 
 

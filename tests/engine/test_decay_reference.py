@@ -43,7 +43,8 @@ def measured():
 
 def test_window_and_kind_are_the_references(measured):
     """Every trace's fit window (first and last time, points) and kind of fit are the
-    reference's, exactly; every kind of fit occurs."""
+    reference's, exactly; the polynomial and the oscillating fits both occur (the plain
+    exponential loses to the polynomial on any trace that is not an exact exponential)."""
     t, traces, names, rec = measured
     kinds = set()
     for j, name in enumerate(names):
