@@ -366,6 +366,97 @@ def _cluster_radius(moduli, n):
     return math.exp(logs / count)
 
 
+#: eigenvalues of the law's one-step map ``R`` whose ``ln`` moduli differ by less than
+#: this (relative) are one repeated eigenvalue (:func:`reference_logs`)
+SAME_MODULUS = 1e-6
+
+
+@njit(cache=True)
+def reference_logs(R):
+    """The distinct ``ln |λ|`` of the eigenvalues of the law's one-step map ``R`` (NaN
+    entries past the distinct ones; none for an empty ``R`` or a zero eigenvalue's
+    ``−inf``): the groups a fitted map's eigenvalues are read in (:func:`_grouped`)."""
+    n = R.shape[0]
+    out = np.full(max(n, 1), math.nan)
+    if n == 0:
+        return out
+    for i in range(n):
+        for q in range(n):
+            if not math.isfinite(R[i, q]):
+                return out
+    lam = np.linalg.eigvals(R.astype(np.complex128))
+    count = 0
+    for i in range(n):
+        m = abs(lam[i])
+        if not (m > 0.0):
+            continue
+        x = math.log(m)
+        new = True
+        for c in range(count):
+            if abs(x - out[c]) <= SAME_MODULUS * max(abs(x), 1e-300):
+                new = False
+        if new:
+            out[count] = x
+            count += 1
+    return out
+
+
+@njit(cache=True)
+def _grouped(moduli, n, ref):
+    """The rate a fitted map's eigenvalue moduli give, read in the groups of the law's
+    spectrum ``ref`` (:func:`reference_logs`): each modulus joins the group of the nearest
+    ``ln |λ|`` of ``R``, and the radius is the geometric mean of the moduli in the group
+    of the largest ``ln |λ|`` that has any.  A repeated eigenvalue of ``R`` (a Jordan
+    block, as a critically damped law gives) splits under a perturbation ``δ`` of the
+    fitted map by ``√δ``, its group's mean (the cluster's determinant) by ``δ``; a simple
+    eigenvalue is its group alone.  Without ``ref`` (a law that is not constant), the
+    moduli within ``CLUSTER`` of the largest in rate (:func:`_cluster_radius`)."""
+    if ref.shape[0] == 0 or not (ref[0] == ref[0]):
+        return _cluster_radius(moduli, n)
+    best = -1
+    for i in range(n):
+        if not (moduli[i] > 0.0) or moduli[i] == math.inf:
+            return _cluster_radius(moduli, n)
+    groups = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        x = math.log(moduli[i])
+        g = 0
+        for c in range(ref.shape[0]):
+            if ref[c] == ref[c] and abs(x - ref[c]) < abs(x - ref[g]):
+                g = c
+        groups[i] = g
+        if best < 0 or ref[g] > ref[best]:
+            best = g
+    logs = 0.0
+    count = 0
+    for i in range(n):
+        if groups[i] == best:
+            logs += math.log(moduli[i])
+            count += 1
+    return math.exp(logs / count)
+
+
+@njit(cache=True)
+def _radius2_grouped(r00, r01, r10, r11, ref):
+    """``ρ`` of the fitted 2 × 2 map ``[[r00, r01], [r10, r11]]`` read in the groups of
+    the law's spectrum (:func:`_grouped`); :func:`_radius2` without it."""
+    if ref.shape[0] == 0 or not (ref[0] == ref[0]):
+        return _radius2(r00, r01, r10, r11)
+    half = 0.5 * (r00 + r11)
+    det = r00 * r11 - r01 * r10
+    disc = half * half - det
+    if not (disc == disc) or not math.isfinite(half):
+        return math.nan
+    m = stack1(2)
+    if disc < 0.0:  # a complex pair: one modulus
+        m[0] = math.sqrt(det)
+        m[1] = m[0]
+    else:
+        m[0] = abs(half + math.sqrt(disc))
+        m[1] = abs(half - math.sqrt(disc))
+    return _grouped(m, 2, ref)
+
+
 @njit(cache=True)
 def _radius2(r00, r01, r10, r11):
     """:func:`spectral_radius_of` of the 2 × 2 matrix ``[[r00, r01], [r10, r11]]`` in
@@ -409,7 +500,27 @@ def spectral_radius_of(R):
 
 
 @njit(cache=True)
-def _pooled_radius(S, j, first):
+def grouped_radius_of(R, ref):
+    """:func:`spectral_radius_of` of a fitted map, its eigenvalues read in the groups of
+    the law's spectrum ``ref`` (:func:`_grouped`)."""
+    n = R.shape[0]
+    if n == 2:
+        return _radius2_grouped(R[0, 0], R[0, 1], R[1, 0], R[1, 1], ref)
+    if n == 1:
+        return abs(R[0, 0])
+    for i in range(n):
+        for q in range(n):
+            if not math.isfinite(R[i, q]):
+                return math.nan
+    lam = np.linalg.eigvals(R.astype(np.complex128))
+    moduli = np.empty(n)
+    for i in range(n):
+        moduli[i] = abs(lam[i])
+    return _grouped(moduli, n, ref)
+
+
+@njit(cache=True)
+def _pooled_radius(S, j, first, ref):
     """``ρ`` of the pooled fits (:func:`map_buffers`): the larger of the 2 × 2 map of
     the ``(f_i, ḟ_i)`` pairs and the 1 × 1 map of the ``h_j``, each where it has data,
     from the pairs of bin ``first`` (those before the level first fell below it); the
@@ -420,15 +531,17 @@ def _pooled_radius(S, j, first):
     rho = -1.0
     det = s[0] * s[3] - s[1] * s[2]
     if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:  # S1 S0⁻¹
-        rho = _radius2((s[4] * s[3] - s[5] * s[2]) / det, (s[5] * s[0] - s[4] * s[1]) / det,
-                       (s[6] * s[3] - s[7] * s[2]) / det, (s[7] * s[0] - s[6] * s[1]) / det)
+        rho = _radius2_grouped((s[4] * s[3] - s[5] * s[2]) / det,
+                               (s[5] * s[0] - s[4] * s[1]) / det,
+                               (s[6] * s[3] - s[7] * s[2]) / det,
+                               (s[7] * s[0] - s[6] * s[1]) / det, ref)  # fmt: skip
     if s[8] > 0.0:
         rho = max(rho, abs(s[9] / s[8]))
     return (rho if rho >= 0.0 else math.nan), s[10]
 
 
 @njit(cache=True)
-def _map_radius(S, j, ng, first):
+def _map_radius(S, j, ng, first, ref):
     """``ρ`` of the least-squares one-step map ``R̂ = S1 S0⁻¹`` from bin ``first`` of
     slot ``j`` (the pairs before its level first fell below that bin), on the directions
     its pairs span, and the number of pairs; NaN with fewer than ``2 ng`` pairs."""
@@ -474,7 +587,7 @@ def _map_radius(S, j, ng, first):
     for q in range(keep):
         for r in range(keep):
             Rr[r, q] /= lam[ng - keep + q]
-    return spectral_radius_of(Rr), pairs
+    return grouped_radius_of(Rr, ref), pairs
 
 
 @njit(cache=True, error_model="numpy")
@@ -531,7 +644,7 @@ def _map_gamma(lt, lv, j, lo, top, beta, u):
 
 
 @njit(cache=True)
-def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry,
+def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref,
                  lowest=0):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
@@ -539,6 +652,8 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry,
     still decaying (``MAP_STILL_DECAYING``), else those from its start until its level
     first fell below ``MAP_MARGIN`` (then ``FLOOR_MARGIN``) times its floor (rounded up
     to a bin of :func:`map_buffers`), give ``R̂`` by least squares; ``β = −ln ρ(R̂)/τ``.
+    ``ref``: the law's spectrum (:func:`reference_logs`; NaN: none), in whose groups the
+    fitted map's eigenvalues are read (:func:`_grouped`).
     For a residual that follows ``g_{k+1} = R g_k`` this is ``−ln ρ(R)/τ`` exactly,
     whatever the window, the modes' mix or a repeated eigenvalue's polynomial prefactor,
     where a fit of the norm's envelope over a short transient is biased.  The pairs must
@@ -571,7 +686,8 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry,
         if top - cut < per_decade:
             continue
         first = (cut + (1 << MAP_SHIFT) - 1) >> MAP_SHIFT  # bins wholly above the cut
-        rho, pairs = _pooled_radius(S, j, first) if pm >= 0 else _map_radius(S, j, ng, first)
+        rho, pairs = (_pooled_radius(S, j, first, ref) if pm >= 0
+                      else _map_radius(S, j, ng, first, ref))  # fmt: skip
         if not (rho < 1.0 and rho > 0.0):
             return False
         beta = -math.log(rho) / tau

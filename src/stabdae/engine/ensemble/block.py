@@ -75,6 +75,7 @@ from ..decay import (
     pairs_full_for,
     pairs_pooled,
     predict,
+    reference_logs,
     scratch,
     spectral_radius_of,
     windows_flush,
@@ -137,6 +138,8 @@ BUFFERS = {
     "dn_b": ("np.empty(B)", "... its distance from the reference's residual"),
     "g_p": ("np.empty(alpha0s.shape[1])", "the linear prediction's g"),
     "gn_p": ("np.empty(alpha0s.shape[1])", "... and its next g"),
+    "ref": ("reference_logs(R)", "the law's distinct ln |eigenvalue|: the groups a fitted "
+            "map's eigenvalues are read in"),
     # the decay measurement (:mod:`..decay`)
     "gs": ("stack1(B)", "‖g‖ at a measured state"),
     "ds": ("stack1(B)", "... its distance from the reference's"),
@@ -363,6 +366,7 @@ def build_block_kernel(K, spec: Spec):
         wmax = stack1(B)
         dmax = stack1(B)
         rho_R = spectral_radius_of(R) if R.shape[0] > 0 else math.nan
+        ref = reference_logs(R)
         g_p = np.empty(alpha0s.shape[1])
         gn_p = np.empty(alpha0s.shape[1])
         for b in range(b_lo, b_hi):
@@ -535,7 +539,7 @@ def build_block_kernel(K, spec: Spec):
                 lowest = min(low[j] << MAP_SHIFT, ladder_level(dn_b[j], base[j]))
                 finish_with_map(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
                                 ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb,
-                                lg)  # fmt: skip
+                                lg, ref)  # fmt: skip
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
                             meas, mcodes, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p,
