@@ -30,7 +30,12 @@ from ._measures import (
     GUIDED,
     HIGH_END_STABLE,
     LOW_END_FAILS,
+    PROBE_UNDECIDED,
     STAGES,
+    V_STABLE,
+    V_UNDECIDED,
+    VERDICTS,
+    ensemble_verdict,
 )
 from ._schema import provenance, schema_variable, variable
 from .engine.ensemble.block import BLOCK
@@ -83,8 +88,12 @@ def boundary(
     rtol : float
         Relative width of the final bracket: ``tau_star_high / tau_star_low ≤ 1 + rtol``.
     q : float
-        Allowed fraction of unstable members: a step is *stable* when the fraction of
-        stable members (``stability_class``) is at least ``1 − q``.
+        Allowed fraction of members not stable: a probe is *stable* when the fraction of
+        stable members (``verdict``) is at least ``1 − q``, *unstable* when more than
+        ``q`` are unstable, and *undecided* otherwise; an undecided probe ends the search
+        (``tau_star_reason`` says so; ``tau_star_low`` and ``tau_star_high`` keep the
+        last decided bracket).  For a constant law no probe past the spectral limit is
+        stable (a member is stable there never), so τ* never lies beyond it.
     members, search_members : int
         Ensemble sizes of the confirmation and of the bisection probes.
     steps : int, optional
@@ -111,7 +120,7 @@ def boundary(
         full ensemble's ``fraction_stable`` at ``tau_star_low`` with its Wilson interval
         and ``members_run``/``members_stable``; every probe (``probe_tau``,
         ``probe_members``, ``probe_fraction_stable``, ``probe_stable``,
-        ``probe_stage``); for a constant law the theory's ``tau_limit_spectral``,
+        ``probe_verdict``, ``probe_stage``); for a constant law the theory's ``tau_limit_spectral``,
         ``tau_limit_weighted_norm`` and ``tau_limit_floor`` (Theorems 6/7 with
         condition 4, see :func:`floor_limit`) and ``spectral_radius`` at τ*.
 
@@ -155,9 +164,10 @@ def boundary(
 
     probes: list[tuple] = []
 
-    def probe(t: float, n: int, stage: int) -> tuple[bool, float]:
-        """Whether the ensemble of ``n`` members is stable at ``t`` (with ``t_end``, at the
-        step ≤ ``t`` that divides the span, which it returns)."""
+    def probe(t: float, n: int, stage: int) -> tuple[int, float]:
+        """The verdict on the ensemble of ``n`` members at ``t`` (with ``t_end``, at the
+        step ≤ ``t`` that divides the span, which it returns):
+        :func:`._measures.ensemble_verdict` with the allowed fraction ``q``."""
         k = steps if t_end is None else max(1, math.ceil(span / t * (1.0 - 1e-12)))
         t = t if t_end is None else span / k
         with warnings.catch_warnings():  # stopped members are what the probe counts
@@ -167,22 +177,30 @@ def boundary(
                           epsilon=epsilon, divergence=divergence, block=block,
                           threads=threads, traces="none")  # fmt: skip
         frac = float(ds.fraction_stable)
-        ok = bool(frac >= 1.0 - q)
-        probes.append((t, n, frac, ok, stage, ds))
-        say(f"{who}: tau = {t:.6g} {'stable' if ok else 'NOT stable'} "
-            f"({int(ds.members_stable)}/{int(ds.members_run)} members; {STAGES[stage]})")
-        return ok, t
+        v = ensemble_verdict(int(ds.members_run), int(ds.members_stable),
+                             int(ds.members_unstable), q)  # fmt: skip
+        probes.append((t, n, frac, v, stage, ds))
+        say(f"{who}: tau = {t:.6g} {VERDICTS[v].upper() if v != V_STABLE else 'stable'} "
+            f"({int(ds.members_stable)} stable, {int(ds.members_unstable)} unstable, "
+            f"{int(ds.members_undecided)} undecided of {int(ds.members_run)} members; "
+            f"{STAGES[stage]})")
+        return v, t
 
     constant = law.is_constant
     A = law.A_tilde(model) if constant else None
     limits = _limits(A, scheme)
 
+    # A probe that cannot decide ends the search: its reason says so, and tau_star_low
+    # and tau_star_high keep the last bracket the probes decided (never a guess).
     reason = BRACKETED
-    ok_lo, lo = probe(lo, search_members, ENDS)
-    if not ok_lo:
-        good, bad, reason = math.nan, lo, LOW_END_FAILS
-    elif (end := probe(hi, search_members, ENDS))[0]:
+    v_lo, lo = probe(lo, search_members, ENDS)
+    if v_lo != V_STABLE:
+        good, bad = math.nan, lo
+        reason = PROBE_UNDECIDED if v_lo == V_UNDECIDED else LOW_END_FAILS
+    elif (end := probe(hi, search_members, ENDS))[0] == V_STABLE:
         good, bad, reason = end[1], math.nan, HIGH_END_STABLE
+    elif end[0] == V_UNDECIDED:
+        good, bad, reason = lo, math.nan, PROBE_UNDECIDED
     else:
         good, bad = lo, end[1]
         spectral = limits["tau_limit_spectral"]
@@ -190,30 +208,41 @@ def boundary(
             for t in (spectral * (1.0 - GUIDE), spectral * (1.0 + GUIDE)):
                 if not good < t < bad:
                     continue
-                ok, t = probe(t, search_members, GUIDED)
-                if ok:
+                v, t = probe(t, search_members, GUIDED)
+                if v == V_STABLE:
                     good = max(good, t)
+                elif v == V_UNDECIDED:
+                    break  # the bisection goes on from the decided bracket
                 else:
                     bad = min(bad, t)
                     break
-        good, bad = _bisect(probe, good, bad, rtol, search_members)
+        good, bad, decided = _bisect(probe, good, bad, rtol, search_members)
+        if not decided:
+            reason = PROBE_UNDECIDED
         # the full ensemble at the largest stable step; where it fails, step down
         # (doubling the step) until it passes, then bisect again with the full ensemble
-        if not probe(good, members, CONFIRM)[0]:
+        elif (v := probe(good, members, CONFIRM)[0]) == V_UNDECIDED:
+            reason = PROBE_UNDECIDED
+        elif v != V_STABLE:
             bad, width = good, rtol
             for _ in range(MAX_CONFIRM):
                 if bad / (1.0 + width) < lo:
                     good, reason = math.nan, CONFIRM_FAILS
                     break
-                ok, t = probe(bad / (1.0 + width), members, CONFIRM)
-                if ok:
+                v, t = probe(bad / (1.0 + width), members, CONFIRM)
+                if v == V_STABLE:
                     good = t
+                    break
+                if v == V_UNDECIDED:
+                    good, reason = math.nan, PROBE_UNDECIDED
                     break
                 bad, width = t, 2.0 * width
             else:
                 good, reason = math.nan, CONFIRM_FAILS
-            if math.isfinite(good):
-                good, bad = _bisect(probe, good, bad, rtol, members, stage=CONFIRM)
+            if reason == BRACKETED:
+                good, bad, decided = _bisect(probe, good, bad, rtol, members, stage=CONFIRM)
+                if not decided:
+                    reason = PROBE_UNDECIDED
 
     star = math.sqrt(good * bad) if reason == BRACKETED else math.nan
     at = _last(probes, good, members)
@@ -230,16 +259,20 @@ def boundary(
 
 def _bisect(probe, good, bad, rtol, n, stage=BISECTION):
     """Geometric bisection of ``[good, bad]`` until ``bad/good ≤ 1 + rtol`` (or until the
-    probes' steps cannot come closer: with ``t_end``, steps that divide the span)."""
+    probes' steps cannot come closer: with ``t_end``, steps that divide the span):
+    ``(good, bad, decided)``, ``decided`` false where a probe was undecided (the bracket
+    is then the last decided one)."""
     while bad > good * (1.0 + rtol):
-        ok, t = probe(math.sqrt(good * bad), n, stage)
+        v, t = probe(math.sqrt(good * bad), n, stage)
         if t <= good or t >= bad:
             break
-        if ok:
+        if v == V_UNDECIDED:
+            return good, bad, False
+        if v == V_STABLE:
             good = t
         else:
             bad = t
-    return good, bad
+    return good, bad, True
 
 
 def _last(probes, t, n):
@@ -327,12 +360,14 @@ def _dataset(model, p, law, scheme, r) -> xr.Dataset:
     }  # fmt: skip
     if at is not None:
         for name in ("fraction_stable", "fraction_stable_low", "fraction_stable_high",
-                     "members_run", "members_stable", "members_diverged", "members_growing"):
+                     "members_run", "members_stable", "members_unstable", "members_undecided",
+                     "members_diverged", "members_growing"):  # fmt: skip
             scalars[name] = at[name].values[()]
     else:
         scalars.update(fraction_stable=math.nan, fraction_stable_low=math.nan,
                        fraction_stable_high=math.nan, members_run=0, members_stable=0,
-                       members_diverged=0, members_growing=0)  # fmt: skip
+                       members_unstable=0, members_undecided=0, members_diverged=0,
+                       members_growing=0)  # fmt: skip
     if r["A"] is not None and math.isfinite(r["tau_star"]):
         scalars["spectral_radius"] = theory.spectral_radius_of(r["A"], scheme, r["tau_star"])
     else:
@@ -343,7 +378,8 @@ def _dataset(model, p, law, scheme, r) -> xr.Dataset:
     columns = {
         "probe_tau": [x[0] for x in probes], "probe_members": [x[1] for x in probes],
         "probe_fraction_stable": [x[2] for x in probes],
-        "probe_stable": [np.int8(x[3]) for x in probes],
+        "probe_stable": [np.int8(x[3] == V_STABLE) for x in probes],
+        "probe_verdict": [np.int8(x[3]) for x in probes],
         "probe_stage": [np.int8(x[4]) for x in probes],
     }  # fmt: skip
     for name, vals in columns.items():

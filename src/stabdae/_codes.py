@@ -10,7 +10,9 @@ code takes a new value.
 
 Families: :class:`Status` (a right-hand side's evaluation or a member's integration),
 :class:`BetaReason` (why a member has a decay rate or not), :class:`FitKind` (which fit
-gave it), :class:`StabilityClass` (a member's class), :class:`TauStarReason` (how a
+gave it), :class:`StabilityClass` (a member's class), :class:`Verdict` and
+:class:`VerdictReason` (a member's verdict and why), :class:`RadiusReason` (how δ* is
+known), :class:`TauStarReason` (how a
 boundary search ended), :class:`ProbeStage` (a boundary search's probes) and
 :class:`LawKind` (how the right-hand side evaluates the law: compile-time, never stored).
 
@@ -25,7 +27,7 @@ import re
 from enum import IntEnum
 
 __all__ = ["BetaReason", "FitKind", "LawKind", "ProbeStage", "Status", "StabilityClass",
-           "TauStarReason", "flag_attrs"]  # fmt: skip
+           "TauStarReason", "RadiusReason", "Verdict", "VerdictReason", "flag_attrs"]  # fmt: skip
 
 
 class _Codes(IntEnum):
@@ -126,6 +128,55 @@ class StabilityClass(_Codes):
     GROWING = 4, "growing"
     DIVERGED = 5, "diverged"
     NOT_RUN = 6, "not_run"
+    #: ran to the end, but the run cannot tell stable from unstable (``verdict_reason``)
+    UNDECIDED = 7, "undecided"
+
+
+class RadiusReason(_Codes):
+    """How δ*, the stability radius, is known (``stability_radius_reason``): a censored
+    statistic where the sample does not bracket it."""
+
+    BRACKETED = 0, "bracketed: between the largest all-stable |alpha0| and the smallest not"
+    ABOVE_SAMPLE = 1, ("> largest sampled: every decided member stable; "
+                       "stability_radius_low is the largest |alpha0| sampled")
+    BELOW_SAMPLE = 2, ("< smallest sampled: no member stable below the smallest unstable; "
+                       "stability_radius_high is its |alpha0|")
+    NO_MEMBER = 3, "no decided member: every member undecided or not run"
+
+
+class Verdict(_Codes):
+    """A member's verdict (``verdict``): what the run shows, judged against the law's
+    theory where ``Ã`` is constant; *undecided* where the run cannot tell."""
+
+    STABLE = 0, "stable"
+    UNSTABLE = 1, "unstable"
+    UNDECIDED = 2, "undecided"
+
+
+class VerdictReason(_Codes):
+    """Why a member has its verdict (``verdict_reason``).  The deviation is the distance
+    of the member's residual from the reference trajectory's; the floor band is
+    ``FLOOR_BAND`` times the reference trajectory's own residual (its truncation floor)
+    over the same fifth of the run; the law's bound is ``sup ‖R(τÃ)^k‖∞ · ‖α⁰‖∞`` over
+    that fifth (``TRANSIENT_SLACK`` times)."""
+
+    DECAYED = 0, "decayed: the deviation ended below its start"
+    WITHIN_BOUND = 1, ("within the law's bound: the deviation stayed under the law's "
+                       "transient bound plus the floor band (rho < 1)")
+    BLEW_UP = 2, "blew up: diverged, non-finite state or singular S"
+    GREW = 3, "grew: the deviation rose over the last three fifths, above the floor band"
+    BEYOND_BOUND = 4, ("grew beyond the law's bound: rho < 1, but the deviation rose above "
+                       "the law's transient bound plus the floor band")
+    STOPPED_IN_TRANSIENT = 5, ("stopped by the divergence threshold inside the law's "
+                               "transient bound (rho < 1): raise divergence")
+    IN_FLOOR_BAND = 6, ("in the floor band: the deviation never rose above the reference "
+                        "trajectory's floor band, and the law has no theory to referee")
+    TOO_SHORT = 7, "too short: the deviation neither ended below its start nor grew"
+    ABOVE_BOUND = 8, ("above the law's bound but not growing (rho < 1): the run does not "
+                      "follow the linear law")
+    DECAYED_RHO_ABOVE_ONE = 9, ("decayed over this run, though rho >= 1: a growing mode may "
+                                "not have been excited above the floor yet")
+    NOT_RUN = 10, "not run: not placed, or out of steps"
 
 
 class TauStarReason(_Codes):
@@ -135,6 +186,8 @@ class TauStarReason(_Codes):
     LOW_END_FAILS = 1, "not stable at the bracket's low end"
     HIGH_END_STABLE = 2, "stable at the bracket's high end"
     CONFIRM_FAILS = 3, "the full ensemble is not stable above the bracket's low end"
+    UNDECIDED = 4, ("a probe could not decide (too many members undecided): tau_star_low "
+                    "and tau_star_high are the last decided bracket, not narrowed to rtol")
 
 
 class ProbeStage(_Codes):

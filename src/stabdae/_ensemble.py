@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import xarray as xr
@@ -51,6 +51,9 @@ DEFAULT_TRACES = 64
 PREDICTION_STEPS = 4096
 #: the most steps (accepted and rejected) an adaptive member may take
 MAX_STEPS = 10_000_000
+#: the default divergence threshold lies this many times above the law's transient bound
+#: for the largest member (:func:`default_divergence`)
+DIVERGENCE_OVER_BOUND = 1e3
 #: the largest reference residual history kept (steps × components; 128 MB)
 REFERENCE_MAX_ENTRIES = 16_000_000
 #: the fixed-step kernel measures the residual at every ``s``-th step, ``s`` at most this
@@ -213,7 +216,10 @@ def ensemble(
         ``stability_class``) and ``max_t ‖g‖ ≤ ε``.  Default ``10 × radius high``.
     divergence : float, optional
         Residual norm above which a member is frozen and flagged ``diverged``
-        (default ``1e3 × epsilon``, and at least 1: a residual of the model's own size).
+        (default ``1e3 × epsilon``, at least 1, a residual of the model's own size, and,
+        for a constant ``Ã``, at least ``1e3`` times the law's transient bound
+        ``sup_k ‖R(τÃ)^k‖∞ · radius high``: a stable law's own transient is not stopped).
+        A member the threshold stops inside the law's transient bound is *undecided*.
     block : int, optional
         Members integrated in lockstep per parallel work item (default 64), or with
         ``rtol`` the lanes that run members side by side, each with its own steps
@@ -242,13 +248,17 @@ def ensemble(
     -------
     xarray.Dataset
         See ``docs/schema.md``: per member ``alpha0``, ``x0``, ``x_final``, ``beta`` with
-        ``beta_reason``, ``gamma``, ``residual_floor``, ``stability_class``, ``stable``,
+        ``beta_reason``, ``gamma``, ``residual_floor``, ``verdict`` (stable, unstable or
+        undecided) with ``verdict_reason`` (:func:`._measures.verdict`; the attribute
+        ``verdict_summary`` counts them), ``stability_class``, ``stable``,
         ``bounded``, ``diverged``, ``status``, ``energy_drift`` and, for constant laws,
         ``beta_predicted`` and ``beta_ratio``; ``residual_norm(trace, time)`` for the
-        traced members; the summaries ``fraction_stable``, ``fraction_bounded`` (with
-        Wilson 95 % intervals), ``beta_median`` (with an order-statistics interval),
-        ``stability_radius`` with its bracket, the counts behind them and, for constant
-        laws, the theory's ``beta_theory``, ``beta_theory_discrete``, ``spectral_radius``.
+        traced members; the summaries ``fraction_stable``, ``fraction_unstable``,
+        ``fraction_undecided``, ``fraction_bounded`` (with Wilson 95 % intervals),
+        ``beta_median`` (with an exact order-statistics interval and its coverage),
+        ``stability_radius`` with its bracket and ``stability_radius_reason``, the counts
+        behind them and, for constant laws, the theory's ``beta_theory``,
+        ``beta_theory_discrete``, ``spectral_radius``.
 
     Warns
     -----
@@ -271,6 +281,7 @@ def ensemble(
     # run's steps, or the prediction's), from one walk over R's powers
     peak, gain = (theory.power_norms(run.R, run.mode.prediction_steps)
                   if run.R.shape[0] > 0 else (math.nan, math.inf))  # fmt: skip
+    referee = _referee(run, g_ref)
     times = run.mode.times(run.t0)
     ds = _ensemble_dataset(
         run.model, run.p, run.law, run.scheme, run.bound, times, x0, alpha0, out.norms,
@@ -283,6 +294,7 @@ def ensemble(
         extra=run.mode.extra(out), overshoot_theory=peak, adaptive=run.adaptive,
         roundoff=_roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
                            run.threads, run.sampled),
+        referee=referee,
     )  # fmt: skip
     if not run.states:
         ds = ds.drop_vars(["x0", "x_final"])
@@ -456,8 +468,7 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
     low, high = check.radius(radius, who)
     seed = check.seed(seed, who)
     epsilon = 10.0 * high if epsilon is None else check.positive(epsilon, "epsilon", who)
-    divergence = (max(1e3 * epsilon, 1.0) if divergence is None
-                  else check.positive(divergence, "divergence", who))  # fmt: skip
+    divergence = None if divergence is None else check.positive(divergence, "divergence", who)
     threads = _threads(threads, who)
     if progress is not None and not callable(progress):
         raise TypeError(f"{who}: progress must be a callable (done, total), got "
@@ -481,9 +492,25 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
         mode = _Fixed(FixedGrid.of(t0, tau, nsteps, save_every), Tableau.of(scheme),
                       ensemble_kernel_for(model, bound, scheme, block),
                       measure_stride(R))  # fmt: skip
+    if divergence is None:
+        divergence = default_divergence(epsilon, high, R, mode.prediction_steps)
     return _RunSpec(model, law, bound, scheme, mode, p, t0, float(t_end), save_dt, block,
                     members, low, high, seed, epsilon, divergence, threads, progress, rdtype,
                     trace_row, traced, bool(states), x0 is None, R, h_pred)  # fmt: skip
+
+
+def default_divergence(epsilon, high, R, steps) -> float:
+    """The default divergence threshold: ``1e3 ε``, at least 1 (a residual of the
+    model's own size), and, where ``Ã`` is constant with a bounded transient, at least
+    ``DIVERGENCE_OVER_BOUND`` times what the law's transient allows the largest member
+    (``sup_k ‖R^k‖∞ · radius high``, :func:`.theory.power_norms`): a stable law's own
+    transient is never stopped as a divergence."""
+    level = max(1e3 * epsilon, 1.0)
+    if R.shape[0] > 0:
+        peak = theory.power_norms(R, steps)[0]
+        if math.isfinite(peak):
+            level = max(level, DIVERGENCE_OVER_BOUND * peak * high)
+    return level
 
 
 def _members(run: _RunSpec, x0):
@@ -535,6 +562,43 @@ def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK,
     if out.status[0] != 0 or not np.isfinite(out.g_out).all():
         return np.zeros((0, ng))
     return out.g_out
+
+
+def _referee(run: _RunSpec, g_ref) -> dict:
+    """What a member's verdict is judged against (:func:`._measures.verdict`): the
+    reference trajectory's largest residual per fifth of the run (its truncation floor:
+    from its stored residuals, or from a run of the mode's kernel on the reference state
+    alone), and, where ``Ã`` is constant, ``ρ`` of the one-step propagator and
+    ``sup ‖R^k‖∞`` per fifth (:func:`.theory.fifth_bounds`)."""
+    if g_ref is not None and g_ref.shape[0] > 1:
+        nsteps = g_ref.shape[0] - 1
+        k = np.arange(nsteps + 1)
+        fifth = np.minimum(4, (5 * k) // nsteps)
+        norms = np.abs(np.asarray(g_ref, dtype=float)).max(axis=1)
+        band = np.array([norms[fifth == w].max(initial=0.0) for w in range(5)])
+    else:
+        band = _reference_floor(run)
+    if run.R.shape[0] == 0:
+        return dict(floor_band=band, bounds=None, rho=math.nan, divergence=run.divergence)
+    rho = float(np.max(np.abs(np.linalg.eigvals(run.R))))
+    return dict(floor_band=band, bounds=theory.fifth_bounds(run.R, run.mode.prediction_steps),
+                rho=rho, divergence=run.divergence)  # fmt: skip
+
+
+def _reference_floor(run: _RunSpec) -> np.ndarray:
+    """The largest residual per fifth of the run of the model's reference state alone
+    (``α⁰ = 0``), measured as the members' (5 numbers; zeros where it did not run to the
+    end)."""
+    x0 = run.model.reference_state(run.p)[None, :]
+    one = replace(run, trace_row=np.full(1, -1), traced=np.zeros(0, dtype=np.int64),
+                  progress=None, divergence=math.inf, threads=1)  # fmt: skip
+    out = run.mode.integrate(one, x0, np.zeros((1, run.model.n_residual)),
+                             np.zeros(1, dtype=np.int8), np.zeros((0, run.model.n_residual)))
+    rec = Record(out.meas, out.codes)
+    band = np.array([rec[f"w{w}"][0] for w in range(5)], dtype=float)
+    if out.status[0] != 0 or not np.isfinite(band).all():
+        return np.zeros(5)
+    return band
 
 
 def _trace_rows(traces, members: int, who: str):

@@ -39,16 +39,20 @@ def _warn_stopped(model, status) -> None:
 def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
                       x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
                       extra=None, roundoff=0.0, overshoot_theory=math.nan,
-                      adaptive=False):  # fmt: skip
+                      adaptive=False, referee=None):  # fmt: skip
     stopped = status != 0
     for name in ("beta_predicted", "beta", "gamma"):  # (not placed: measured on nothing)
         meas[name][stopped] = np.nan
     reason = meas["reason"]
     reason[stopped & (reason == decay.R_FITTED)] = decay.R_STOPPED
-    cls = _measures.classify(meas, status, epsilon, roundoff)
+    # γ bounds the transient β was fitted on: none without β (beta_reason says why)
+    gamma = meas["gamma"]
+    gamma[~np.isfinite(meas["beta"]) | ~np.isfinite(gamma)] = np.nan
+    verdicts, why = _measures.verdict(meas, status, roundoff=roundoff, **(referee or {}))
+    cls = _measures.classify(meas, status, epsilon, verdicts)
     alpha_norm = np.max(np.abs(alpha0), axis=1)
-    summary, radius_why = _measures.summaries(meas, cls, alpha_norm, epsilon)
-    stable, bounded = _measures.flags(meas, cls, epsilon)
+    summary, radius_why = _measures.summaries(meas, verdicts, why, cls, alpha_norm, epsilon)
+    stable, bounded = _measures.flags(meas, verdicts, epsilon)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         overshoot = meas["largest"] / meas["initial"]
     diverged = cls == _measures.DIVERGED
@@ -76,6 +80,8 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
         "fit_end": times[0] + meas["fit_end"],
         "fit_points": meas["fit_points"],
         "fit_kind": meas["fit_kind"].astype(np.int8),
+        "verdict": verdicts,
+        "verdict_reason": why,
         "stability_class": cls,
         "stable": stable.astype(np.int8),
         "bounded": bounded.astype(np.int8),
@@ -109,6 +115,9 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
     )
     data["stability_radius"].attrs["comment"] = radius_why
     attrs = provenance(model, p, law, scheme, f"ensemble of {x0.shape[0]} members", **run)
+    attrs["verdict_summary"] = _measures.verdict_summary(verdicts, why, cls != _measures.NOT_RUN)
+    if referee is not None:
+        attrs["reference_floor"] = np.asarray(referee["floor_band"], dtype=float)
     attrs["residual_norm_dtype"] = str(norms.dtype)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 

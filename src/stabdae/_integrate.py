@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
 import xarray as xr
 
 from . import _validate as check
+from . import theory
 from ._codes import Status
 from ._model import Model
 from ._schema import trajectory_dataset
@@ -34,6 +36,7 @@ def integrate(
     multiplier: str = "ldl",
     projection: str | None = None,
     with_multipliers: bool = False,
+    divergence: float | None = None,
 ) -> xr.Dataset:
     """Integrate one trajectory of the stabilized equations (3.1), (3.11).
 
@@ -63,6 +66,12 @@ def integrate(
         How λ is solved from (3.11): ``"ldl"`` factorizes ``S`` and stops with status
         ``SINGULAR_S`` when it is singular (redundant constraints); ``"lstsq"`` takes the
         minimum-norm least-squares λ (pseudo-inverse of ``S``) and keeps integrating.
+    divergence : float, optional
+        Residual norm above which the trajectory is reported diverged (status
+        ``DIVERGED``, with an :class:`IntegrationWarning`; the samples after the first one
+        above it are NaN).  Default: 1000 times the initial residual, at least 1 (a
+        residual of the model's own size), and for a constant ``Ã`` at least 1000 times
+        the law's transient bound ``sup_k ‖R(τÃ)^k‖∞ ‖g(x0)‖∞``.
     with_multipliers : bool, default False
         Also store the multipliers λ of (3.11) (``multiplier(time, constraint)``, with
         ``M v̇ = Fᵀλ − γ``) and the accelerations ``acceleration(time, coordinate)`` at the
@@ -111,6 +120,15 @@ def integrate(
         scheme.A, scheme.b, scheme.c, sweeps, tol, out_x, out_g, out_e,
     )  # fmt: skip
     status = Status(status)
+    if status == Status.OK:  # a trajectory that ran to the end, but far off its manifold
+        norms = np.abs(out_g).max(axis=1)
+        level = _divergence(model, law, scheme, tau, nsteps, norms[0], divergence, who)
+        over = np.flatnonzero(~(norms <= level))
+        if over.size:
+            first = int(over[0])
+            status, done = Status.DIVERGED, first * save_every
+            for arr in (out_x, out_g, out_e):
+                arr[first + 1:] = np.nan
     if status != Status.OK:
         warnings.warn(
             f"integrate({model.name}): stopped at step {done} (t = {t0 + done * tau:g}) of "
@@ -127,6 +145,20 @@ def integrate(
         multipliers=_multipliers(model, bound, multiplier, times, out_x, p)
         if with_multipliers else None,
     )  # fmt: skip
+
+
+def _divergence(model, law, scheme, tau, nsteps, g0, divergence, who) -> float:
+    """The divergence threshold of one trajectory (``integrate``'s ``divergence``)."""
+    if divergence is not None:
+        return check.positive(divergence, "divergence", who)
+    g0 = float(g0) if np.isfinite(g0) else 0.0
+    level = max(1.0, 1e3 * g0)
+    if law.is_constant:
+        R = theory.step_matrix(np.asarray(law.A_tilde(model), dtype=float), scheme, tau)
+        peak = theory.power_norms(R, nsteps)[0]
+        if math.isfinite(peak):
+            level = max(level, 1e3 * peak * g0)
+    return level
 
 
 def _multipliers(model, bound, multiplier, times, xs, p):

@@ -1,32 +1,43 @@
-"""What an ensemble reports: each member's class with its reason, and the summaries with
-their uncertainty.
+"""What an ensemble reports: each member's verdict with its reason, its class, and the
+summaries with their uncertainty.
 
-Per member (from the measures of :mod:`.engine.decay`: its initial norm, the largest norm
-over each fifth of the run ``W0 … W4``, the floor ``W4``) a *stability class*:
+Per member a *verdict* (:func:`verdict`): ``stable``, ``unstable`` or ``undecided``, with
+the reason.  It is read on the member's deviation from the reference trajectory (the
+unperturbed motion, ``α⁰ = 0``), whose own residual is the truncation floor: a floor
+that varies, or grows with the motion, is the same for every member up to the floor's
+variation from state to state, and is no instability.  Where ``Ã`` is constant the
+discrete theory referees: with ``ρ(R(τÃ)) < 1`` a member is stable while its deviation
+stays within the law's transient bound ``sup_k ‖R^k‖∞ ‖α⁰‖∞`` (plus the floor band) and
+is called unstable only where it left that bound and grew, or blew up where the bound
+does not reach the divergence threshold.  Where a run cannot tell, the verdict is
+``undecided``, never a guess.
+
+Per member also a *stability class*, what happened to its raw residual:
 
 ``decayed``
-    fell below where it started and stayed within ε;
+    stable, fell below where it started and stayed within ε;
 ``overshoot``
     as ``decayed``, but above ε on the way: the law's own transient (a critically damped
     law's ``‖e^{Ãt}‖∞`` peaks near ``ω/e``); ``overshoot`` (largest / initial norm) is
     stored beside the law's ``sup_k ‖R(τÃ)^k‖∞``;
 ``at floor``
-    started within reach of the scheme's floor and stayed there, within ε;
+    stable, started within reach of the scheme's floor and stayed there, within ε;
 ``floor above epsilon``
-    not growing, but the floor itself (the scheme's local error at this step) lies above
-    ε: a property of the step size, not an instability;
+    stable, settled on a floor (the scheme's local error at this step) above ε: a
+    property of the step size, not an instability;
 ``growing``
-    the largest norm of each of the last three fifths grows, and the last is at least
-    ``decay.GROWTH`` times the third, above what roundoff can build up: unstable over this
-    run, though not yet diverged;
+    unstable, not stopped;
 ``diverged``
     stopped by the divergence threshold, a non-finite state or a singular ``S``;
+``undecided``
+    ran to the end, but the run cannot tell;
 ``not run``
     not placed, or an adaptive member that ran out of steps.
 
-*Stable* is one of the first four; *bounded* (Definition 2 of the paper) is stable with
-the largest norm within ε.  The fractions come with Wilson 95 % intervals, the median
-decay rate with an order-statistics interval, and every summary with the counts behind it.
+*Bounded* (Definition 2 of the paper) is stable with the largest norm within ε.  The
+fractions come with Wilson 95 % intervals, the median decay rate with an exact
+distribution-free interval from order statistics, and every summary with the counts
+behind it.
 """
 
 from __future__ import annotations
@@ -34,12 +45,22 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import stats
 
-from ._codes import ProbeStage, StabilityClass, Status, TauStarReason, messages
+from ._codes import (
+    ProbeStage,
+    RadiusReason,
+    StabilityClass,
+    Status,
+    TauStarReason,
+    Verdict,
+    VerdictReason,
+    messages,
+)
 from .engine import decay
 
 #: class codes of ``stability_class`` (:class:`stabdae._codes.StabilityClass`)
-DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON, GROWING, DIVERGED, NOT_RUN = (
+DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON, GROWING, DIVERGED, NOT_RUN, UNDECIDED = (
     int(c) for c in StabilityClass)
 CLASSES = tuple(c.message for c in StabilityClass)
 STABLE = (DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON)
@@ -47,7 +68,8 @@ STABLE = (DECAYED, OVERSHOOT, AT_FLOOR, FLOOR_ABOVE_EPSILON)
 Z95 = 1.959963984540054
 
 #: codes of a boundary search's ``tau_star_reason`` (:class:`stabdae._codes.TauStarReason`)
-BRACKETED, LOW_END_FAILS, HIGH_END_STABLE, CONFIRM_FAILS = (int(c) for c in TauStarReason)
+BRACKETED, LOW_END_FAILS, HIGH_END_STABLE, CONFIRM_FAILS, PROBE_UNDECIDED = (
+    int(c) for c in TauStarReason)
 TAU_STAR_REASONS = messages(TauStarReason)
 #: a boundary search's probe stages (``probe_stage``, :class:`stabdae._codes.ProbeStage`)
 ENDS, GUIDED, BISECTION, CONFIRM = (int(c) for c in ProbeStage)
@@ -55,37 +77,131 @@ STAGES = messages(ProbeStage)
 
 #: how far above the roundoff it can build up a rising residual must be to be growth
 ROUNDOFF_MARGIN = 10.0
+#: codes of ``verdict`` (:class:`stabdae._codes.Verdict`) and ``verdict_reason``
+V_STABLE, V_UNSTABLE, V_UNDECIDED = (int(c) for c in Verdict)
+VERDICTS = messages(Verdict)
+VERDICT_REASONS = messages(VerdictReason)
+#: codes of ``stability_radius_reason`` (:class:`stabdae._codes.RadiusReason`)
+RADIUS_REASONS = messages(RadiusReason)
+#: a deviation within this many times the reference trajectory's own residual (its
+#: truncation floor, over the same fifth of the run) is the floor's variation from member
+#: to member (the floor depends on the state, and a chaotic motion takes each member's
+#: state away from the reference's), not a sign of the law
+FLOOR_BAND = 10.0
+#: a member of a law with ``ρ < 1`` is held to ``TRANSIENT_SLACK`` times the linear
+#: bound ``sup ‖R^k‖∞ ‖α⁰‖∞`` (the residual follows ``g_{k+1} = R g_k`` up to terms of
+#: second order in ``α⁰``)
+TRANSIENT_SLACK = 2.0
 
 _BLOWN_UP = (Status.DIVERGED, Status.NONFINITE_STATE, Status.SINGULAR_S, Status.MASS_NOT_SPD)
 
 
 def classify(meas: decay.Record, status: np.ndarray, epsilon: float,
-             roundoff: float = 0.0) -> np.ndarray:  # fmt: skip
+             verdicts: np.ndarray) -> np.ndarray:  # fmt: skip
     """The stability class of each member (int8, codes of :data:`CLASSES`) from its
-    measurement record ``meas``.
-
-    ``roundoff``: the size of the residual that roundoff alone can build up by the end of
-    the run (:func:`roundoff_level` at the final states, times the law's
-    :func:`stabdae.theory.forced_gain` where it is known).  A member grows only where its
-    last fifth rises above ``ROUNDOFF_MARGIN`` times that: below it, a residual that
-    rises is roundoff growing with the size of the state (a model whose coordinates
-    drift), not an instability."""
+    measurement record ``meas`` and its verdict (:func:`verdict`): a stable member is
+    ``decayed``, ``overshoot``, ``at floor`` or ``floor above epsilon`` by its raw
+    residual against ``epsilon``; an unstable one ``diverged`` (stopped) or ``growing``;
+    an undecided one that ran ``undecided`` (``diverged`` where the divergence threshold
+    stopped it)."""
     initial, largest = meas["initial"], meas["largest"]
     w2, w3, w4 = meas["w2"], meas["w3"], meas["w4"]
     with np.errstate(invalid="ignore"):
-        growing = decay.grows(w2, w3, w4) & (w4 > ROUNDOFF_MARGIN * roundoff)
         fell = w4 < initial
         within = largest <= epsilon
-        floor_ok = w4 <= epsilon
+        # settled: the raw residual no longer falls a factor per fifth (it is on its floor)
+        still = (w2 >= decay.STILL_DECAYING * w3) & (w3 >= decay.STILL_DECAYING * w4)
+        floor_high = ~still & (w4 > epsilon)
     cls = np.full(status.shape, AT_FLOOR, dtype=np.int8)
-    cls[~floor_ok] = FLOOR_ABOVE_EPSILON
-    cls[fell & floor_ok & within] = DECAYED
-    cls[fell & floor_ok & ~within] = OVERSHOOT
-    cls[growing] = GROWING
+    cls[fell & within] = DECAYED
+    cls[fell & ~within] = OVERSHOOT
+    cls[floor_high] = FLOOR_ABOVE_EPSILON
+    cls[verdicts == V_UNSTABLE] = GROWING
+    cls[verdicts == V_UNDECIDED] = UNDECIDED
     blown = np.isin(status, [int(s) for s in _BLOWN_UP])
     cls[blown] = DIVERGED
     cls[(status != 0) & ~blown] = NOT_RUN
     return cls
+
+
+def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None,
+            rho: float = math.nan, divergence: float = math.inf,
+            roundoff: float = 0.0) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Each member's verdict and its reason (int8 codes of :data:`VERDICTS` and
+    :data:`VERDICT_REASONS`).
+
+    Read on the member's *deviation*, the distance of its residual from the reference
+    trajectory's (``d2 … d4`` of ``meas``: its largest over the last three fifths of the
+    run; the residual itself where there is no reference), against its start ``d0``
+    (``meas["initial"]``) and:
+
+    * ``floor_band``: per fifth of the run, the reference trajectory's largest residual
+      (its truncation floor; 5 numbers, None: unknown, taken as 0).  The deviation from
+      member to member of a floor that depends on the state lies within ``FLOOR_BAND``
+      times it, together with ``ROUNDOFF_MARGIN`` times ``roundoff``;
+    * ``bounds``: per fifth, ``sup ‖R(τÃ)^k‖∞`` over its steps, and ``rho = ρ(R(τÃ))``,
+      where ``Ã`` is constant (:func:`stabdae.theory.fifth_bounds`): the law's theory,
+      which then referees.
+
+    With the theory and ``ρ < 1``: *stable* where the deviation over the last fifth lies
+    within ``TRANSIENT_SLACK`` times the law's bound plus the floor band; *unstable* only
+    where it blew up past what the bound allows, or rose over the last three fifths
+    (:func:`stabdae.engine.decay.grows`) beyond the bound; otherwise *undecided*.  With
+    ``ρ ≥ 1``: *unstable* where it blew up or grew; a member that decayed is undecided
+    (the growing mode may lie under the floor).  Without the theory: *unstable* where it
+    blew up, or grew above the floor band and its start; *stable* where it ended below
+    its start; *undecided* otherwise (in the floor band, or the run too short)."""
+    R_ = VerdictReason
+    d0 = np.asarray(meas["initial"], dtype=float)
+    d2, d3, d4 = (np.asarray(meas[c], dtype=float) for c in ("d2", "d3", "d4"))
+    band = np.zeros(5) if floor_band is None else np.asarray(floor_band, dtype=float)
+    noise = FLOOR_BAND * np.nan_to_num(band, nan=0.0) + ROUNDOFF_MARGIN * roundoff
+    theory_known = bounds is not None and math.isfinite(rho)
+    with np.errstate(invalid="ignore", over="ignore"):
+        # growth is resolved only where each of the last three fifths holds a measured
+        # state (a run of a few steps leaves them empty: -inf)
+        resolved = np.isfinite(d2) & np.isfinite(d3) & np.isfinite(d4)
+        grew = resolved & decay.grows(d2, d3, d4) & (d4 > noise[4])
+        ended_low = d4 < d0
+        if theory_known:
+            allowed = TRANSIENT_SLACK * np.asarray(bounds, dtype=float)[4] * d0 + noise[4]
+            peak = TRANSIENT_SLACK * float(np.max(bounds)) * d0 + float(noise.max())
+            within = d4 <= allowed
+    verdict = np.full(status.shape, V_UNDECIDED, dtype=np.int8)
+    reason = np.full(status.shape, int(R_.TOO_SHORT), dtype=np.int8)
+
+    def put(mask, v, r):
+        verdict[mask] = v
+        reason[mask] = int(r)
+
+    if theory_known and rho < 1.0:
+        put(~within & ~grew, V_UNDECIDED, R_.ABOVE_BOUND)
+        put(~within & grew, V_UNSTABLE, R_.BEYOND_BOUND)
+        put(within & ~ended_low, V_STABLE, R_.WITHIN_BOUND)
+        put(within & ended_low, V_STABLE, R_.DECAYED)
+    elif theory_known:
+        # ρ ≥ 1: the reference trajectory's own residual grows with the law's growing
+        # mode, so it is no floor; growth past the member's start is evidence enough
+        with np.errstate(invalid="ignore"):
+            grew = resolved & decay.grows(d2, d3, d4) & ((d4 > d0) | (d4 > noise[4]))
+        put(ended_low & ~grew, V_UNDECIDED, R_.DECAYED_RHO_ABOVE_ONE)
+        put(grew, V_UNSTABLE, R_.GREW)
+    else:
+        with np.errstate(invalid="ignore"):
+            in_band = (d0 <= noise[0]) & (d4 <= noise[4])
+        put(in_band, V_UNDECIDED, R_.IN_FLOOR_BAND)
+        put(ended_low & ~grew, V_STABLE, R_.DECAYED)
+        with np.errstate(invalid="ignore"):
+            put(grew & (d4 > d0), V_UNSTABLE, R_.GREW)
+    blown = np.isin(status, [int(s) for s in _BLOWN_UP])
+    put(blown, V_UNSTABLE, R_.BLEW_UP)
+    if theory_known and rho < 1.0:
+        # the divergence threshold stopped a transient the law allows: no evidence
+        with np.errstate(invalid="ignore"):
+            excused = (status == int(Status.DIVERGED)) & (divergence <= peak)
+        put(excused, V_UNDECIDED, R_.STOPPED_IN_TRANSIENT)
+    put((status != 0) & ~blown, V_UNDECIDED, R_.NOT_RUN)
+    return verdict, reason
 
 
 def roundoff_level(residual_rows, states, t: float) -> float:
@@ -131,63 +247,109 @@ def wilson(successes: int, n: int) -> tuple[float, float]:
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
-def median_interval(values) -> tuple[float, float, float]:
-    """The median of the finite values with a distribution-free 95 % interval from order
-    statistics (ranks ``n/2 ∓ 1.96 √n / 2``); NaN where there are too few values."""
+def median_interval(values, level: float = 0.95) -> tuple[float, float, float, float]:
+    """The median of the finite values with its distribution-free interval from order
+    statistics, and that interval's exact coverage: ``(median, low, high, coverage)``.
+
+    ``[v_(r), v_(n+1−r)]`` (1-based order statistics) covers the median of any
+    continuous distribution with probability ``1 − 2 P(B ≤ r − 1)``, ``B ~ Bin(n, 1/2)``
+    (:data:`scipy.stats.binom`); ``r`` is the largest rank with coverage at least
+    ``level``.  Where even ``[min, max]`` covers less (``n ≤ 5`` at 95 %), that is the
+    interval, with its lower coverage; NaN for no values."""
     v = np.sort(np.asarray(values, dtype=float)[np.isfinite(values)])
     n = v.size
     if n == 0:
-        return math.nan, math.nan, math.nan
+        return math.nan, math.nan, math.nan, math.nan
     med = float(np.median(v))
-    half = Z95 * math.sqrt(n) / 2.0
-    lo, hi = int(math.floor(n / 2.0 - half)), int(math.ceil(n / 2.0 + half))
-    if lo < 0 or hi > n - 1:
-        return med, math.nan, math.nan
-    return med, float(v[lo]), float(v[hi])
+    r = np.arange(1, n // 2 + 1)
+    cover = 1.0 - 2.0 * stats.binom.cdf(r - 1, n, 0.5)
+    ok = np.flatnonzero(cover >= level)
+    k = int(r[ok[-1]]) if ok.size else 1
+    coverage = float(1.0 - 2.0 * stats.binom.cdf(k - 1, n, 0.5)) if n > 1 else 0.0
+    return med, float(v[k - 1]), float(v[n - k]), coverage
 
 
-def stability_radius(alpha_norm, stable, ran) -> tuple[float, float, float, str]:
-    """δ* with its bracket: ``(δ*, low, high, reason)``.  ``high`` is the smallest
-    ``‖α⁰‖`` of a member that was not stable, ``low`` the largest below it (every member
-    up to ``low`` was stable); δ* is their geometric mean, NaN with a reason when the
-    sample does not bracket it."""
-    a, ok = np.asarray(alpha_norm)[ran], np.asarray(stable)[ran]
+def stability_radius(alpha_norm, stable, decided) -> tuple[float, float, float, int]:
+    """δ* with its bracket: ``(δ*, low, high, reason)`` (reason: a code of
+    :data:`RADIUS_REASONS`), over the members with a verdict (``decided``: stable or
+    unstable).  ``high`` is the smallest ``‖α⁰‖`` of an unstable member, ``low`` the
+    largest below it (every member up to ``low`` was stable); δ* is their geometric
+    mean.  Where the sample does not bracket it, δ* is censored: NaN, with the side the
+    sample bounds it from (``low``: it is above the largest sampled; ``high``: below the
+    smallest unstable)."""
+    a, ok = np.asarray(alpha_norm)[decided], np.asarray(stable)[decided]
     if a.size == 0:
-        return math.nan, math.nan, math.nan, "no member ran"
+        return math.nan, math.nan, math.nan, int(RadiusReason.NO_MEMBER)
     if ok.all():
-        return math.nan, float(a.max()), math.nan, "every member stable: delta* is above the sample"
+        return math.nan, float(a.max()), math.nan, int(RadiusReason.ABOVE_SAMPLE)
     high = float(a[~ok].min())
     below = a[a < high]
     if below.size == 0:
-        return math.nan, math.nan, high, "no member stable below the smallest failure"
+        return math.nan, math.nan, high, int(RadiusReason.BELOW_SAMPLE)
     low = float(below.max())
-    return math.sqrt(low * high), low, high, "bracketed"
+    return math.sqrt(low * high), low, high, int(RadiusReason.BRACKETED)
 
 
-def flags(meas, cls, epsilon):
+def flags(meas, verdicts, epsilon):
     """Per member: ``(stable, bounded)``, bounded being stable and within ε at every step
     (Definition 2)."""
-    stable = np.isin(cls, STABLE)
+    stable = verdicts == V_STABLE
     with np.errstate(invalid="ignore"):
         return stable, stable & (meas["largest"] <= epsilon)
 
 
-def summaries(meas, cls, alpha_norm, epsilon) -> dict:
-    """The ensemble's scalar summaries with their intervals and counts."""
+def summaries(meas, verdicts, reasons, cls, alpha_norm, epsilon) -> tuple[dict, str]:
+    """The ensemble's scalar summaries with their intervals and counts, and why δ* is
+    what it is."""
     ran = cls != NOT_RUN
-    stable, bounded = flags(meas, cls, epsilon)
+    stable, bounded = flags(meas, verdicts, epsilon)
     n = int(ran.sum())
     beta = meas["beta"]
     out = {"members_run": n, "members_stable": int((stable & ran).sum()),
+           "members_unstable": int(((verdicts == V_UNSTABLE) & ran).sum()),
+           "members_undecided": int(((verdicts == V_UNDECIDED) & ran).sum()),
            "members_bounded": int((bounded & ran).sum()),
            "members_diverged": int((cls == DIVERGED).sum()),
            "members_growing": int((cls == GROWING).sum()),
            "members_with_beta": int(np.isfinite(beta).sum())}  # fmt: skip
-    for name, k in (("fraction_stable", out["members_stable"]),
-                    ("fraction_bounded", out["members_bounded"])):  # fmt: skip
-        out[name] = k / n if n else math.nan
-        out[name + "_low"], out[name + "_high"] = wilson(k, n)
-    out["beta_median"], out["beta_median_low"], out["beta_median_high"] = median_interval(beta)
-    delta, low, high, why = stability_radius(alpha_norm, stable, ran)
-    out.update(stability_radius=delta, stability_radius_low=low, stability_radius_high=high)
-    return out, why
+    for name in ("stable", "unstable", "undecided", "bounded"):
+        k = out["members_" + name]
+        out["fraction_" + name] = k / n if n else math.nan
+        out[f"fraction_{name}_low"], out[f"fraction_{name}_high"] = wilson(k, n)
+    (out["beta_median"], out["beta_median_low"], out["beta_median_high"],
+     out["beta_median_coverage"]) = median_interval(beta)  # fmt: skip
+    decided = ran & (verdicts != V_UNDECIDED)
+    delta, low, high, why = stability_radius(alpha_norm, stable, decided)
+    out.update(stability_radius=delta, stability_radius_low=low, stability_radius_high=high,
+               stability_radius_reason=why)  # fmt: skip
+    return out, RADIUS_REASONS[why]
+
+
+def ensemble_verdict(n_run: int, n_stable: int, n_unstable: int, q: float = 0.0) -> int:
+    """The verdict on a whole ensemble (a code of :data:`VERDICTS`): stable where at
+    least ``1 − q`` of the members that ran are stable, unstable where more than ``q``
+    are unstable, undecided otherwise (or where none ran)."""
+    if n_run == 0:
+        return V_UNDECIDED
+    if n_stable >= (1.0 - q) * n_run:
+        return V_STABLE
+    if n_unstable > q * n_run:
+        return V_UNSTABLE
+    return V_UNDECIDED
+
+
+def verdict_summary(verdicts, reasons, ran) -> str:
+    """One line a user reads first: the counts of each verdict, the undecided and the
+    unstable by reason."""
+    n = int(ran.sum())
+    parts = []
+    for v, name in VERDICTS.items():
+        sel = ran & (verdicts == v)
+        k = int(sel.sum())
+        text = f"{k} {name}"
+        if k and v != V_STABLE:
+            why = np.unique(reasons[sel], return_counts=True)
+            text += " (" + "; ".join(f"{c} {VERDICT_REASONS[int(r)].split(':')[0]}"
+                                     for r, c in zip(*why)) + ")"  # fmt: skip
+        parts.append(text)
+    return f"of {n} members that ran: " + ", ".join(parts)

@@ -31,9 +31,12 @@ from ._codes import (
     BetaReason,
     FitKind,
     ProbeStage,
+    RadiusReason,
     StabilityClass,
     Status,
     TauStarReason,
+    Verdict,
+    VerdictReason,
     flag_attrs,
 )
 from ._vector_width import PREFER_512
@@ -54,7 +57,7 @@ MULTIPLIER, ACCELERATION = "@multiplier", "@acceleration"
 #: summaries are computed before, in double precision).  Residual norms, their ratios and
 #: the energy stay double (a diverging member's exceed the single range), and so does
 #: ``alpha0_norm``, which the stability radius's bracket quotes.
-SINGLE_PRECISION = ("beta", "gamma", "fit_start", "fit_end", "beta_predicted", "beta_ratio")
+SINGLE_PRECISION = ("beta", "fit_start", "fit_end", "beta_predicted", "beta_ratio")
 #: per-member counts, stored as 32-bit integers
 COUNTS = ("fit_points", "diverged_step", "steps_accepted", "rhs_evaluations")
 
@@ -105,9 +108,12 @@ SCHEMA: dict[str, tuple] = {
                        "exp(A~ t) alpha0), same window and fit", "s-1", {}),
     "beta_ratio": ("member", "beta / beta_predicted", "1", {}),
     "beta_ratio_median": ((), "median of beta / beta_predicted", "1", {}),
+    "verdict": ("member", "verdict: stable, unstable or undecided", "1", flag_attrs(Verdict)),
+    "verdict_reason": ("member", "why the member has its verdict", "1",
+                       flag_attrs(VerdictReason)),
     "stability_class": ("member", "stability class", "1", flag_attrs(StabilityClass)),
-    "stable": ("member", "decayed, overshot by the law's transient, or sat at the floor "
-               "(not growing, not diverged)", "1", _FLAG),
+    "stable": ("member", "verdict stable: the deviation from the reference trajectory "
+               "decayed, or stayed within the law's transient bound", "1", _FLAG),
     "bounded": ("member", "stable and within epsilon (Definition 2)", "1", _FLAG),
     "diverged": ("member", "stopped: blew up (diverged, non-finite or singular S)", "1",
                  _FLAG),
@@ -120,6 +126,15 @@ SCHEMA: dict[str, tuple] = {
     "fraction_stable": ((), "fraction of stable members (of those that ran)", "1", {}),
     "fraction_stable_low": ((), "Wilson 95% interval of fraction_stable, low", "1", {}),
     "fraction_stable_high": ((), "Wilson 95% interval of fraction_stable, high", "1", {}),
+    "fraction_unstable": ((), "fraction of unstable members (of those that ran)", "1", {}),
+    "fraction_unstable_low": ((), "Wilson 95% interval of fraction_unstable, low", "1", {}),
+    "fraction_unstable_high": ((), "Wilson 95% interval of fraction_unstable, high", "1",
+                               {}),
+    "fraction_undecided": ((), "fraction of undecided members (of those that ran)", "1", {}),
+    "fraction_undecided_low": ((), "Wilson 95% interval of fraction_undecided, low", "1",
+                               {}),
+    "fraction_undecided_high": ((), "Wilson 95% interval of fraction_undecided, high", "1",
+                                {}),
     "fraction_bounded": ((), "fraction of bounded members (of those that ran)", "1", {}),
     "fraction_bounded_low": ((), "Wilson 95% interval of fraction_bounded, low", "1", {}),
     "fraction_bounded_high": ((), "Wilson 95% interval of fraction_bounded, high", "1", {}),
@@ -132,11 +147,18 @@ SCHEMA: dict[str, tuple] = {
     "beta_median": ((), "median measured decay rate", "s-1", {}),
     "beta_median_low": ((), "95% order-statistics interval of beta_median, low", "s-1", {}),
     "beta_median_high": ((), "95% order-statistics interval of beta_median, high", "s-1", {}),
+    "beta_median_coverage": ((), "exact coverage of the beta_median interval (binomial "
+                             "order statistics; below 0.95 only for 5 or fewer values)", "1",
+                             {}),
+    "stability_radius_reason": ((), "how delta* is known (censored where the sample does "
+                                "not bracket it)", "1", flag_attrs(RadiusReason)),
     "members_run": ((), "members that ran (placed, not out of steps)", "1", {}),
     "members_stable": ((), "stable members", "1", {}),
     "members_bounded": ((), "bounded members", "1", {}),
     "members_diverged": ((), "diverged members", "1", {}),
     "members_growing": ((), "growing members", "1", {}),
+    "members_unstable": ((), "unstable members", "1", {}),
+    "members_undecided": ((), "undecided members", "1", {}),
     "members_with_beta": ((), "members with a measured beta", "1", {}),
     # --- the theorems' predictions (ensemble, study grid)
     "beta_theory": ((), "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1", {}),
@@ -166,6 +188,9 @@ SCHEMA: dict[str, tuple] = {
     "probe_tau": ("probe", "step size of the probe", "s", {}),
     "probe_members": ("probe", "members of the probe's ensemble", "1", {}),
     "probe_fraction_stable": ("probe", "fraction of stable members at the probe", "1", {}),
+    "probe_verdict": ("probe", "the probe's verdict: stable (at least 1 - q of its members "
+                      "stable), unstable (more than q unstable) or undecided", "1",
+                      flag_attrs(Verdict)),
     "probe_stable": ("probe", "the probe counted as stable (fraction at least 1 - q)", "1",
                      _FLAG),
     "probe_stage": ("probe", "stage of the search", "1", flag_attrs(ProbeStage)),
@@ -210,13 +235,17 @@ _GROUPS = (
         "residual_norm", "alpha0", "alpha0_norm", "x0", "x_final", "beta", "beta_reason",
         "gamma", "residual_floor", "floor_reached", "max_residual", "final_residual",
         "overshoot", "fit_start", "fit_end", "fit_points", "fit_kind", "beta_predicted",
-        "beta_ratio", "stability_class", "stable", "bounded", "diverged", "diverged_step",
-        "status", "steps_accepted", "rhs_evaluations", "energy_drift", "fraction_stable",
-        "fraction_stable_low", "fraction_stable_high", "fraction_bounded",
-        "fraction_bounded_low", "fraction_bounded_high", "stability_radius",
-        "stability_radius_low", "stability_radius_high", "beta_median", "beta_median_low",
-        "beta_median_high", "beta_ratio_median", "members_run", "members_stable",
-        "members_bounded", "members_diverged", "members_growing", "members_with_beta",
+        "beta_ratio", "verdict", "verdict_reason", "stability_class", "stable", "bounded",
+        "diverged", "diverged_step", "status", "steps_accepted", "rhs_evaluations",
+        "energy_drift", "fraction_stable", "fraction_stable_low", "fraction_stable_high",
+        "fraction_unstable", "fraction_unstable_low", "fraction_unstable_high",
+        "fraction_undecided", "fraction_undecided_low", "fraction_undecided_high",
+        "fraction_bounded", "fraction_bounded_low", "fraction_bounded_high",
+        "stability_radius", "stability_radius_low", "stability_radius_high",
+        "stability_radius_reason", "beta_median", "beta_median_low", "beta_median_high",
+        "beta_median_coverage", "beta_ratio_median", "members_run", "members_stable",
+        "members_unstable", "members_undecided", "members_bounded", "members_diverged",
+        "members_growing", "members_with_beta",
         "overshoot_theory", "beta_theory", "beta_theory_discrete",
         "spectral_radius", "norm_max", "norm_weighted", "norm_condition", "lambda_min_W",
         "beta_theorem5_proven", "beta_theorem5_printed", "gamma_theorem5",
@@ -232,9 +261,10 @@ _GROUPS = (
     ("A boundary search: `boundary` (and per grid point, `stabdae run` with `[search]`)", (
         "tau_star", "tau_star_low", "tau_star_high", "tau_star_reason", "fraction_stable",
         "fraction_stable_low", "fraction_stable_high", "members_run", "members_stable",
-        "members_diverged", "members_growing", "tau_limit_spectral", "tau_limit_weighted_norm",
-        "tau_limit_floor", "spectral_radius", "probe_tau", "probe_members",
-        "probe_fraction_stable", "probe_stable", "probe_stage")),
+        "members_unstable", "members_undecided", "members_diverged", "members_growing",
+        "tau_limit_spectral", "tau_limit_weighted_norm", "tau_limit_floor", "spectral_radius",
+        "probe_tau", "probe_members", "probe_fraction_stable", "probe_stable",
+        "probe_verdict", "probe_stage")),
     ("Theorems 6/7 along a trajectory: `theory.along_path` (the variables drop the `path_` "
      "prefix)", ("path_spectral_radius", "path_norm_max", "path_norm_2", "path_norm_weighted",
                  "path_remainder", "path_residual_norm", "path_q", "path_bound_start")),
@@ -293,8 +323,10 @@ def schema_markdown() -> str:
 
 #: the stored code variables and their families, as the schema page lists them
 _CODE_VARIABLES = (("status", Status), ("beta_reason", BetaReason), ("fit_kind", FitKind),
-                   ("stability_class", StabilityClass), ("tau_star_reason", TauStarReason),
-                   ("probe_stage", ProbeStage))  # fmt: skip
+                   ("verdict", Verdict), ("verdict_reason", VerdictReason),
+                   ("stability_class", StabilityClass),
+                   ("stability_radius_reason", RadiusReason),
+                   ("tau_star_reason", TauStarReason), ("probe_stage", ProbeStage))  # fmt: skip
 
 
 # --------------------------------------------------------------------- units

@@ -12,6 +12,8 @@ import pytest
 
 import stabdae
 from conftest import baumgarte_ensemble, load_scene
+from stabdae._codes import RadiusReason, VerdictReason
+from stabdae._measures import V_STABLE, V_UNDECIDED, V_UNSTABLE
 from stabdae.engine import decay
 
 
@@ -59,8 +61,10 @@ def test_beta_leaves_out_the_lead_of_the_transient(xi, scheme):
 def test_stability_radius_is_bracketed():
     """Members at known radii 1e-5 … 2e-1 with ε = 1e-3: the three that start above ε are
     not bounded (but stable: they decay), the two below it are; with every member stable
-    δ* is not bracketed (NaN, its low end the largest radius); with a divergence threshold
-    that stops the two largest members, δ* lies between 1e-2 and 1e-1."""
+    δ* is censored (NaN, above the largest radius, its low end).  A divergence threshold
+    of 0.05 stops the two largest members inside the law's transient bound
+    (2 sup‖R^k‖ ‖α⁰‖ > 0.05): no evidence either way, so they are undecided and δ* stays
+    censored above the largest decided radius."""
     model = load_scene("pendulum")
     radii = (1e-5, 1e-4, 1e-2, 2e-1, 1e-1)
     x0 = np.concatenate([stabdae.sample_perturbations(model, 1, (r, r), seed=i)[0]
@@ -76,17 +80,18 @@ def test_stability_radius_is_bracketed():
         cut = stabdae.ensemble(model, stabdae.baumgarte(10.0, 1.0), "midpoint", 1e-3, 2.0,
                                x0=x0, epsilon=1e-3, divergence=0.05)  # fmt: skip
     a = cut.alpha0_norm.values
-    # two members stop: δ*'s upper end is the smaller of their radii
     assert cut.stable.values.tolist() == [1, 1, 1, 0, 0]
-    assert float(cut.stability_radius_low) == a[2] and float(cut.stability_radius_high) == a[4]
-    assert a[2] < float(cut.stability_radius) < a[4]
+    assert cut.verdict.values.tolist() == [V_STABLE] * 3 + [V_UNDECIDED] * 2
+    assert cut.verdict_reason.values[3:].tolist() == [int(VerdictReason.STOPPED_IN_TRANSIENT)] * 2
+    assert int(cut.stability_radius_reason) == int(RadiusReason.ABOVE_SAMPLE)
+    assert np.isnan(float(cut.stability_radius)) and float(cut.stability_radius_low) == a[2]
 
 
 def test_bounded_needs_the_residual_to_have_decayed():
     """An unstable law (f̈ = 5 f) over 1 s: a member that starts with ḟ = 1e-6 (and f = 0)
-    grows as ḟ₀ cosh(√5 t), to about 4.7e-6, stays far below ε = 1 and is still not
-    bounded, since it did not decay; members on the manifold (their residual stays at
-    roundoff) are bounded."""
+    grows as ḟ₀ cosh(√5 t), to about 4.7e-6, stays far below ε = 1 and is unstable, not
+    bounded; members on the manifold (their residual stays at roundoff, which the law
+    would grow too) are undecided: the run cannot tell, the theory says ρ > 1."""
     model = load_scene("pendulum")
     x_ref = model.reference_state()
     q = x_ref[:2]
@@ -97,7 +102,9 @@ def test_bounded_needs_the_residual_to_have_decayed():
                           epsilon=1.0)  # fmt: skip
     assert (ds.status.values == 0).all() and float(ds.max_residual[7]) < 1e-4
     assert float(ds.residual_norm[7, -1]) > 3 * float(ds.alpha0_norm[7])
-    assert ds.bounded.values.tolist() == [1] * 7 + [0]
+    assert ds.bounded.values.tolist() == [0] * 8
+    assert ds.verdict.values.tolist() == [V_UNDECIDED] * 7 + [V_UNSTABLE]
+    assert int(ds.verdict_reason[7]) == int(VerdictReason.GREW)
 
 
 def test_beta_does_not_depend_on_the_storage_interval():
@@ -158,21 +165,42 @@ def test_stability_classes():
 
 def test_wilson_and_median_intervals():
     """Wilson's 95 % interval at its textbook values (0 of 10: [0, 0.2775]; 5 of 10:
-    [0.2366, 0.7634]); the median's interval at its ranks, covering the true median of
-    normal samples about 95 % of the time."""
+    [0.2366, 0.7634]).  The median's interval ``[v_(r), v_(n+1-r)]`` with the largest
+    rank whose exact coverage ``1 − 2^{1−n} Σ_{i<r} C(n, i)`` (counted here with integer
+    binomials) is at least 95 %: defined for every n ≥ 1 (``[min, max]`` below n = 6, with
+    its lower coverage), and covering the true median of normal samples as often as it
+    says, at small and large n."""
+    from math import comb
+
     from stabdae._measures import median_interval, wilson
 
     np.testing.assert_allclose(wilson(0, 10), (0.0, 0.2775), atol=5e-5)
     np.testing.assert_allclose(wilson(5, 10), (0.2366, 0.7634), atol=5e-5)
-    x = np.random.default_rng(0).standard_normal(10_000)
-    med, lo, hi = median_interval(x)
-    v = np.sort(x)  # ranks n/2 ∓ 1.96 √n / 2 = 5000 ∓ 98
-    assert (med, lo, hi) == (np.median(x), v[4902], v[5098])
-    # over many samples the interval covers the true median (0) about 95 % of the time
-    rng = np.random.default_rng(1)
-    cover = [lo <= 0 <= hi for lo, hi in (median_interval(rng.standard_normal(400))[1:]
-                                          for _ in range(2000))]  # fmt: skip
-    assert 0.93 < np.mean(cover) < 0.97
+
+    def exact(n):  # the largest rank r with coverage ≥ 0.95, and that coverage
+        cov, tail = [], 0
+        for r in range(1, n // 2 + 1):
+            tail += comb(n, r - 1)  # Σ_{i<r} C(n, i), exactly
+            cov.append(1 - 2 * tail / 2**n)
+        ok = [r for r, c in zip(range(1, n // 2 + 1), cov) if c >= 0.95]
+        r = ok[-1] if ok else 1
+        return r, (cov[r - 1] if n > 1 else 0.0)
+
+    rng = np.random.default_rng(0)
+    for n in list(range(1, 41)) + [399, 400, 10_000]:
+        x = rng.standard_normal(n)
+        med, lo, hi, cover = median_interval(x)
+        r, c = exact(n)
+        v = np.sort(x)
+        assert (med, lo, hi) == (np.median(x), v[r - 1], v[n - r]), n
+        assert cover == pytest.approx(c, rel=1e-12, abs=1e-15), n
+        assert (cover >= 0.95) == (n >= 6), n
+    # over many samples the interval covers the true median (0) as often as stated
+    for n in (7, 20, 400):
+        _, _, _, stated = median_interval(rng.standard_normal(n))
+        hits = [lo <= 0 <= hi for lo, hi in (median_interval(rng.standard_normal(n))[1:3]
+                                             for _ in range(4000))]  # fmt: skip
+        assert abs(np.mean(hits) - stated) < 4 * math.sqrt(stated * (1 - stated) / 4000), n
 
 
 @pytest.mark.parametrize("scheme", ["euler", "midpoint", "rk4"])

@@ -168,3 +168,27 @@ def test_recommended_gains_in_closed_form():
     assert m["k"] == pytest.approx(50, rel=1e-8) and m["rho_first_order"] == pytest.approx(0.5)
     with pytest.raises(ValueError, match="recommend_gain: tau must be positive"):
         theory.recommend_gain("rk4", 0.0)
+
+
+@pytest.mark.parametrize("steps", [1, 500])
+def test_short_probes_never_pass_the_spectral_limit(steps):
+    """Probes of one step cannot resolve growth: the search says a probe could not decide
+    instead of a bracket.  On the affine system (exact: no floor) 500 steps decide every
+    probe and τ* is the spectral limit, to rtol; on the pendulum τ* never lies beyond
+    it (a member is never stable at ρ ≥ 1)."""
+    from stabdae._codes import TauStarReason
+
+    for model, law in ((affine, stabdae.baumgarte(10, 1, k=10)),
+                       (load_scene("pendulum"), stabdae.baumgarte(10, 1))):  # fmt: skip
+        ds = stabdae.boundary(model, law, "midpoint", tau=(1e-3, 1.0), steps=steps,
+                              rtol=1e-2, members=64, search_members=32)  # fmt: skip
+        limit = float(ds.tau_limit_spectral)
+        if steps == 1:
+            assert int(ds.tau_star_reason) == int(TauStarReason.UNDECIDED)
+            assert math.isnan(float(ds.tau_star))
+        elif model is affine:
+            assert int(ds.tau_star_reason) == int(TauStarReason.BRACKETED)
+            assert float(ds.tau_star_low) <= limit <= float(ds.tau_star_high)
+            assert float(ds.tau_star_high) <= limit * 1.011
+        assert not float(ds.tau_star_low) > limit
+        assert not float(ds.tau_star) > limit * 1.011

@@ -51,7 +51,7 @@ def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) ->
 
 
 def summary(ds: xr.Dataset) -> str:
-    """Per grid point: fractions stable and bounded, δ*, median β (with the members that
+    """Per grid point: fractions stable, undecided and bounded, δ*, median β (with the members that
     have one) beside the predictions; for a boundary search, τ* with its bracket beside
     the theory's limits."""
     if "tau_star" in ds:
@@ -64,17 +64,20 @@ def summary(ds: xr.Dataset) -> str:
                 "ensemble) and high; tau_floor: Theorems 6/7 with the floor the local error "
                 "forces; tau_spectral: rho(R) = 1):")  # fmt: skip
         return "\n" + head + "\n" + grid_table(ds, cols, short, precise=cols[:5]) + "\n"
-    cols = [c for c in ("fraction_stable", "fraction_bounded", "stability_radius",
+    cols = [c for c in ("fraction_stable", "fraction_undecided", "fraction_bounded",
+                        "stability_radius",
                         "beta_median", "members_with_beta", "beta_ratio_median",
                         "beta_theory_discrete", "spectral_radius", "norm_condition",
                         "beta_theorem5_proven", "beta_theorem5_printed") if c in ds]  # fmt: skip
-    short = {"fraction_stable": "stable", "fraction_bounded": "bounded",
+    short = {"fraction_stable": "stable", "fraction_undecided": "undecided",
+             "fraction_bounded": "bounded",
              "stability_radius": "delta*", "beta_median": "beta_med",
              "members_with_beta": "n_beta", "beta_ratio_median": "meas/lin",
              "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
              "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
              "beta_theorem5_printed": "b5_printed"}  # fmt: skip
-    head = ("summary (stable, bounded: fractions of members; delta*: stability radius; "
+    head = ("summary (stable, undecided, bounded: fractions of members (undecided: the run "
+            "cannot tell, see verdict_reason); delta*: stability radius; "
             "n_beta: members with a measured beta; meas/lin: median of measured over the "
             "linear prediction's beta; beta_pred = -ln rho(R)/tau):")  # fmt: skip
     return "\n" + head + "\n" + grid_table(ds, cols, short, flags=("norm_condition",)) + "\n"
