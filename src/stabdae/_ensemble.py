@@ -193,7 +193,10 @@ def ensemble(
     tau, t_end, save_dt : float
         Fixed step, final time, spacing of stored residual norms (as in :func:`integrate`;
         default ``save_dt``: about 200 samples).  With ``rtol``, ``tau`` is every member's
-        first step and ``save_dt`` need not be a multiple of it.
+        first step and ``save_dt`` need not be a multiple of it; the steps are not cut to
+        the sample times, so nothing measured depends on ``save_dt`` (a stored sample
+        is the residual of the state's cubic Hermite interpolant between the accepted steps
+        around it).
     rtol, atol : float, optional
         Adaptive steps: each member controls its own step with the scheme's embedded pair
         (Dormand–Prince 5(4) by default, or DOP853; as :func:`integrate_adaptive`) to

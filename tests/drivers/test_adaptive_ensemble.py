@@ -28,11 +28,12 @@ def test_adaptive_members_control_their_own_steps(pair):
     assert len(set(steps.tolist())) == len(angles), steps  # every member its own count
     for j in range(len(angles)):
         one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, scheme=pair, rtol=1e-8,
-                                         atol=1e-10, save_dt=0.5, first_step=1e-3)  # fmt: skip
+                                         atol=1e-10, save_dt=2.0, first_step=1e-3)  # fmt: skip
         assert one.attrs["method"] == pair and one.attrs["steps_accepted"] == steps[j]
         assert one.attrs["rhs_evaluations"] == ds.rhs_evaluations.values[j]
         np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
-        np.testing.assert_array_equal(ds.residual_norm.values[j], one.residual_norm.values)
+        np.testing.assert_array_equal(ds.residual_norm.values[j, [0, -1]],
+                                      one.residual_norm.values)  # fmt: skip
 
 
 @pytest.mark.parametrize("pair", ["dopri5", "dop853"])
@@ -59,11 +60,12 @@ def test_lanes_attempt_and_adaptive_loop_agree_bit_for_bit(pair):
     assert steps.max() >= 4 * steps.min(), steps
     for j in good:
         one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, scheme=pair, rtol=1e-8,
-                                         atol=1e-10, save_dt=0.25, first_step=1e-3)  # fmt: skip
+                                         atol=1e-10, save_dt=2.0, first_step=1e-3)  # fmt: skip
         assert one.attrs["steps_accepted"] == ds.steps_accepted.values[j]
         assert one.attrs["rhs_evaluations"] == ds.rhs_evaluations.values[j]
         np.testing.assert_array_equal(ds.x_final.values[j], one.x.values[-1])
-        np.testing.assert_array_equal(ds.residual_norm.values[j], one.residual_norm.values)
+        np.testing.assert_array_equal(ds.residual_norm.values[j, [0, -1]],
+                                      one.residual_norm.values)  # fmt: skip
     with pytest.warns(stabdae.IntegrationWarning):
         other = stabdae.ensemble(model, law, pair, block=8, threads=2, **kw)
     for name in ("residual_norm", "x_final", "steps_accepted", "rhs_evaluations", "beta",
@@ -123,6 +125,36 @@ def test_adaptive_ensemble_beta_and_determinism():
     assert "beta_theory_discrete" not in a
     for name in ("residual_norm", "x_final", "steps_accepted"):
         np.testing.assert_array_equal(a[name].values, b[name].values)
+
+
+def test_adaptive_samples_change_no_step():
+    """The steps are not cut to the sample times: with ``save_dt`` left out, 0.01 and
+    0.001 every member takes the same steps and every measure has the same bits.  The
+    stored samples are the residual of the dense output between the steps: within 0.5 % of the
+    residual of states integrated to the sample times (``integrate_adaptive``, whose steps
+    end there) wherever it lies far above the floor."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    radius = (1e-4, 1e-2)
+    kw = dict(tau=1e-3, t_end=2.0, members=16, radius=radius, seed=1, rtol=1e-8,
+              residual_dtype="float64", traces="all")  # fmt: skip
+    runs = [stabdae.ensemble(model, law, "dopri5", save_dt=dt, **kw)
+            for dt in (None, 0.01, 0.001)]  # fmt: skip
+    assert [r.sizes["time"] for r in runs] == [201, 201, 2001]
+    for name in ("beta", "beta_reason", "verdict", "residual_floor", "max_residual",
+                 "steps_accepted", "rhs_evaluations", "x_final", "beta_median"):  # fmt: skip
+        for other in runs[1:]:
+            np.testing.assert_array_equal(runs[0][name].values, other[name].values, name)
+    assert (runs[0].beta_reason.values == decay.R_FITTED).sum() >= 12
+    ds = runs[2]
+    x0, _, _ = stabdae.sample_perturbations(model, 16, radius, seed=1)
+    for j in range(4):
+        one = stabdae.integrate_adaptive(model, x0[j], law, 2.0, scheme="dopri5", rtol=1e-8,
+                                         atol=1e-8, save_dt=0.001, first_step=1e-3)  # fmt: skip
+        ref, got = one.residual_norm.values, ds.residual_norm.values[j]
+        far = ref > 1e3 * float(ds.residual_floor[j])
+        assert far.sum() >= 100, far.sum()
+        np.testing.assert_allclose(got[far], ref[far], rtol=5e-3)
 
 
 def test_adaptive_ensemble_isolates_divergence():

@@ -19,6 +19,26 @@ from ..rhs import kernels_for
 from ..rk.adaptive import _pattern, attempt_for
 from ..rk.control import _DIVERGED, _f_eval, _first_step, _next_step, _settle
 
+
+# ------------------------------------------------------------------- samples
+@njit(cache=True)
+def _hermite(x0, f0, x1, f1, h, theta, out):
+    """The cubic Hermite interpolant at ``t0 + θ h`` of an accepted step from ``x0`` (with
+    ``ẋ = f0``) to ``x1`` (``f1``), in ``out``.
+
+    The ensemble's steps are not cut to the sample times, so that the steps taken, and
+    with them the residual's floor and every measure of the decay, do not depend on
+    ``save_dt``; a stored sample is the residual of this dense output of the state (its
+    error ``O(h⁴)``, below the step's own error at the tolerances the pairs are used
+    at)."""
+    for l in range(x0.shape[0]):
+        d = x1[l] - x0[l]
+        out[l] = (x0[l] + theta * d
+                  + theta * (theta - 1.0) * ((1.0 - 2.0 * theta) * d
+                                             + (theta - 1.0) * h * f0[l]
+                                             + theta * h * f1[l]))  # fmt: skip
+
+
 # ------------------------------------------------------------------- lanes in lockstep
 #: members integrated side by side (lanes) in the block adaptive ensemble kernel
 LANES = 8
@@ -57,9 +77,11 @@ BUFFERS = {
     "ws_h": ("make_workspace()", "the right-hand side's workspace"),
     "x_h": ("np.empty(N2)", "a member's state"),
     "k0_h": ("np.empty(N2)", "its first stage"),
-    "k1_h": ("np.empty(N2)", "the first step's trial stage"),
-    "xs_h": ("np.empty(N2)", "the first step's trial state"),
+    "k1_h": ("np.empty(N2)", "the first step's trial stage; ẋ at a step's end"),
+    "xs_h": ("np.empty(N2)", "the first step's trial state; a sample's state"),
     "g_h": ("np.empty(ng)", "a member's residual"),
+    "x_o": ("np.empty(N2)", "the state at the start of a step with samples inside"),
+    "k_o": ("np.empty(N2)", "... and its ẋ"),
     "lt, lv, base": ("ladders(B)", "each lane's ladder"),
     "rt, ry, fa, fb, lg": ("scratch()", "the fits' scratch"),
     "g_p": ("np.empty(alpha0s.shape[1])", "the linear prediction's g"),
@@ -156,6 +178,8 @@ def _build_adaptive_block(K, spec: Spec):
         k1_h = np.empty(N2)
         xs_h = np.empty(N2)
         g_h = np.empty(ng)
+        x_o = np.empty(N2)
+        k_o = np.empty(N2)
         lt, lv, base = ladders(B)
         rt, ry, fa, fb, lg = scratch()
         g_p = np.empty(alpha0s.shape[1])
@@ -180,7 +204,13 @@ def _build_adaptive_block(K, spec: Spec):
                                                        hit[lane], after[lane], expo)
                     if ok:
                         acc_n[lane] += 1
-                        t = save_times[jj[lane]] if hit[lane] else T[lane] + hh
+                        t_old = T[lane]
+                        t = tend if hit[lane] else t_old + hh
+                        inside = jj[lane] < nsave - 1 and save_times[jj[lane]] <= t
+                        if inside:  # samples inside the step: keep its start
+                            for l in range(N2):
+                                x_o[l] = X[l, lane]
+                                k_o[l] = K0[l, lane]
                         T[lane] = t
                         for l in range(N2):
                             X[l, lane] = XN[l, lane]
@@ -188,7 +218,26 @@ def _build_adaptive_block(K, spec: Spec):
                         window = min(4, int(5.0 * (t - t0) / span))
                         observe(lt, lv, base, meas, lane, i, t - t0, RN[lane], RN[lane],
                                 window)  # fmt: skip
-                        if hit[lane]:
+                        if inside:  # ... its end
+                            for l in range(N2):
+                                x_h[l] = X[l, lane]
+                                k1_h[l] = K0[l, lane]
+                        while inside and jj[lane] < nsave - 1 and save_times[jj[lane]] <= t:
+                            ts = save_times[jj[lane]]
+                            _hermite(x_o, k_o, x_h, k1_h, hh, (ts - t_old) / hh, xs_h)
+                            residual(ts, xs_h, p, ws_h, g_h)
+                            r = 0.0
+                            for l in range(ng):
+                                r = max(r, abs(g_h[l]))
+                            if not math.isfinite(r):
+                                r = math.inf
+                            jj[lane] += 1
+                            if trace_row[i] >= 0:
+                                norms[trace_row[i], jj[lane]] = r
+                            if not (r <= divergence):
+                                st = _DIVERGED
+                                break
+                        if hit[lane] and st == 0:
                             jj[lane] += 1
                             for l in range(N2):
                                 x_h[l] = X[l, lane]
@@ -207,8 +256,7 @@ def _build_adaptive_block(K, spec: Spec):
                     else:
                         rej_n[lane] += 1
                 if i >= 0 and st == 0:  # the next attempt: its step, or a stop
-                    HH[lane], hit[lane], st = _next_step(T[lane], H[lane],
-                                                         save_times[jj[lane]],
+                    HH[lane], hit[lane], st = _next_step(T[lane], H[lane], tend,
                                                          acc_n[lane] + rej_n[lane],
                                                          max_steps)  # fmt: skip
                 if i >= 0 and st != 0:  # the member's end: its outputs
@@ -271,7 +319,7 @@ def _build_adaptive_block(K, spec: Spec):
                         h, nf = first_step(t0, x_h, k0_h, k1_h, xs_h, p, law_mat, law_scal,
                                            ws_h, rtol, atol, h0, tend, expo)  # fmt: skip
                         fev_n[lane] += nf
-                        hh, hit[lane], st = _next_step(t0, h, save_times[0], 0, max_steps)
+                        hh, hit[lane], st = _next_step(t0, h, tend, 0, max_steps)
                     if st != 0:
                         for l in range(N2):
                             x_final[i, l] = x_h[l]
