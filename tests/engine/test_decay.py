@@ -12,6 +12,7 @@ from numba import njit
 
 import stabdae
 from conftest import load_scene
+from stabdae._codes import Verdict
 from stabdae.engine import decay
 
 
@@ -361,3 +362,21 @@ def test_member_rates_at_a_double_eigenvalue():
                           traces="none")  # fmt: skip
     ratio = ds.beta.values / float(ds.beta_theory_discrete)
     assert np.mean(np.abs(ratio - 1) <= 0.01) >= 0.985
+
+
+def test_a_floor_rising_with_the_motion_is_no_growth():
+    """The double pendulum under Euler (τ = 1e-4, 5 s): each member's deviation from the
+    reference trajectory decays by two decades or more, then rises again as its chaotic
+    motion drifts from the reference's, and its floor with it.  That late rise is no
+    growth that keeps the member from its one-step map: two thirds of the members 10×
+    above their floor get a β (a fifth did when the rise was read as growth), and every
+    β given is the law's rate −ln ρ(R)/τ to 1 %."""
+    model = load_scene("double_pendulum")
+    ds = stabdae.ensemble(model, stabdae.baumgarte(10.0, 1.0), "euler", 1e-4, 5.0,
+                          members=128, radius=(1e-3, 1e-1), seed=1)  # fmt: skip
+    above = ds.alpha0_norm.values >= 10.0 * ds.residual_floor.values
+    ratio = ds.beta_ratio.values[above]
+    assert above.sum() >= 40 and (ds.verdict.values[above] == Verdict.STABLE).all()
+    assert np.isfinite(ratio).mean() >= 0.6, np.isfinite(ratio).mean()
+    given = ratio[np.isfinite(ratio)]
+    np.testing.assert_allclose(given, 1.0, atol=0.01)

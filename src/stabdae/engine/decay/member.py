@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-from .fit import STILL_DECAYING, estimate, grows, refit
+from .fit import MIN_DECADES, STILL_DECAYING, estimate, grows, refit
 from .ladder import ladder_base, ladder_clear, ladder_level, records
 from .onestep import map_estimate, spectral_radius_of
 from .record import (
@@ -96,12 +96,18 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
     ``j`` has no point; ``ref`` the law's spectrum, :func:`reference_logs`): β from the
     map where it has one, else from the envelope.  A member whose largest norms grow
     (:func:`grows`) gets the map only when the envelope does not find it growing (it may
-    decay first, which the map would read), so its envelope is fitted first."""
+    decay first, which the map would read), so its envelope is fitted first; unless the
+    last fifth's largest norm lies a decade (``MIN_DECADES``) or more below the start:
+    then the rise is the floor's, moving with the motion."""
     still = summarize(meas, codes, row, final, stopped)
     if stopped:
         return
     out = meas[row]
-    if grows(out[C_D2], out[C_D3], out[C_D4]):
+    # a late rise a decade or more below the start is the floor moving with the motion
+    # (the member drifting from the reference), not growth: the map reads the transient
+    # before it
+    drift = out[C_D4] * 10.0**MIN_DECADES <= out[C_INITIAL]
+    if grows(out[C_D2], out[C_D3], out[C_D4]) and not drift:
         fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
