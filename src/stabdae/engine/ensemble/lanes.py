@@ -28,9 +28,9 @@ def _hermite(x0, f0, x1, f1, h, theta, out):
 
     The ensemble's steps are not cut to the sample times, so that the steps taken, and
     with them the residual's floor and every measure of the decay, do not depend on
-    ``save_dt``; a stored sample is the residual of this dense output of the state (its
-    error ``O(h⁴)``, below the step's own error at the tolerances the pairs are used
-    at)."""
+    ``save_dt``; a stored sample is the residual of this dense output of the state.  Its
+    error is ``O(h⁴)``, and between steps it can lie above the residual's floor: the
+    decay is measured on the accepted steps only, never on the samples."""
     for l in range(x0.shape[0]):
         d = x1[l] - x0[l]
         out[l] = (x0[l] + theta * d
@@ -66,7 +66,7 @@ BUFFERS = {
     "GOOD": ("stack_int1(B)", "whether the attempt's right-hand sides succeeded"),
     "NEV": ("stack_int1(B)", "the attempt's evaluations"),
     "H": ("np.empty(B)", "the next step the control proposes"),
-    "hit": ("np.zeros(B, dtype=np.bool_)", "the attempt ends on a sample time"),
+    "hit": ("np.zeros(B, dtype=np.bool_)", "the attempt ends on t_end"),
     "after": ("np.zeros(B, dtype=np.bool_)", "the last step was rejected (no growth)"),
     "jj": ("np.zeros(B, dtype=np.int64)", "the next sample"),
     "mem": ("np.full(B, -1, dtype=np.int64)", "the lane's member (−1: none)"),
