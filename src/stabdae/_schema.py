@@ -63,8 +63,8 @@ COUNTS = ("fit_points", "diverged_step", "steps_accepted", "rhs_evaluations")
 
 _FLAG = {"flag_values": [0, 1], "flag_meanings": "no yes"}
 
-_HELD = {**_FLAG, "comment": "judged above 10x the member's residual floor, that floor added "
-         "to the bound"}  # fmt: skip
+_HELD = {**_FLAG, "comment": "judged on the stored residual traces (one per trace), above "
+         "10x the member's residual floor, that floor added to the bound"}  # fmt: skip
 
 #: name -> (dims, long_name, units, extra attributes).  ``dims`` of theory variables of a
 #: study's grid are the grid's axes (given when built).
@@ -200,9 +200,9 @@ SCHEMA: dict[str, tuple] = {
     "beta_theorem5_printed": ((), "Theorem 5 rate k0 w0 l1^2/lm as printed, w0^2 = "
                               "lambda_min(W)", "s-1", {}),
     "gamma_theorem5": ("member", "Theorem 5 prefactor |alpha0|_2 sqrt(lm/l1)", RESIDUAL, {}),
-    "bound_proven_held": ("member", "|alpha(t)| <= gamma exp(-beta t) held, proven beta", "1",
+    "bound_proven_held": ("trace", "|alpha(t)| <= gamma exp(-beta t) held, proven beta", "1",
                           _HELD),
-    "bound_printed_held": ("member", "|alpha(t)| <= gamma exp(-beta t) held, printed beta",
+    "bound_printed_held": ("trace", "|alpha(t)| <= gamma exp(-beta t) held, printed beta",
                            "1", _HELD),
     "theorem5_lambda_min_W": ((), "Theorem 5: min eigenvalue of W = h_v h_v^T near the "
                               "manifold", "1", {}),

@@ -290,6 +290,23 @@ def test_shipped_studies_load_from_the_repository_root(name, monkeypatch):
     assert study.output == root / "results" / name.replace(".toml", ".nc")
 
 
+
+def test_shipped_theorem5_study_runs_with_more_members_than_traces(monkeypatch):
+    """The shipped Theorem 5 study as written (256 members, 64 stored traces): its grid
+    point runs, and the bound is judged on the stored traces, one flag per trace."""
+    from stabdae.study.run import run_point
+
+    root = Path(__file__).resolve().parents[2]
+    monkeypatch.chdir(root)
+    study = load_study(root / "studies" / "sleigh_theorem5_tau_k.toml")
+    *_, (_, values) = study.points()  # the largest step: the cheapest point
+    ds = run_point(study, values)
+    assert ds.sizes["member"] == study.ensemble["members"] > ds.sizes["trace"] > 0
+    for which in ("proven", "printed"):
+        held = ds[f"bound_{which}_held"]
+        assert held.dims == ("trace",) and set(np.unique(held.values)) <= {0, 1}
+
+
 SEARCH = """
 [model]
 file = "pendulum"
