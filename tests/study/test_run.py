@@ -241,39 +241,81 @@ def test_resume_after_a_model_edit_recomputes_and_equals_a_clean_run(tmp_path, m
     same_data(got, xr.open_dataset(clean / "out" / "study.nc").load())
 
 
-def test_force_and_bad_parts_are_computed_again(tmp_path, monkeypatch):
-    """Each part is checked before it is used: a part of another grid point, a truncated
-    and an empty part are computed again (and say so); --force discards parts that pass
-    the check too.  Every way ends with the dataset of a clean run."""
+def test_bad_parts_are_computed_again_and_force_keeps_good_ones(tmp_path, monkeypatch):
+    """Each part is checked before it is used: a part of another grid point, a truncated,
+    an empty and an altered part (its checksum differs from the one recorded when it was
+    written) are computed again, and say so.  --force replaces the finished output but
+    resumes from the parts of this run.  Every way ends with the dataset of a clean run."""
     study = study_file(tmp_path, members=16, t_end=0.2, omegas="5.0")
     (tmp_path / "ref").mkdir()
     clean = run_study(study_file(tmp_path / "ref", members=16, t_end=0.2, omegas="5.0"),
                       progress=False, log=lambda *a: None)  # fmt: skip
     parts = tmp_path / "out" / "study.nc.parts"
-    _interrupted(study, 4, monkeypatch)
+    _interrupted(study, 5, monkeypatch)
     (parts / "point-0.nc").write_bytes((parts / "point-1.nc").read_bytes())  # a foreign part
     data = (parts / "point-2.nc").read_bytes()
     (parts / "point-2.nc").write_bytes(data[: len(data) // 2])  # truncated
     (parts / "point-3.nc").write_bytes(b"")  # empty
+    with xr.open_dataset(parts / "point-4.nc") as part:  # opens, right key, other numbers
+        tampered = part.load()
+    tampered["fraction_bounded"] = tampered.fraction_bounded * 0 + 0.5
+    write_netcdf(tampered, parts / "point-4.nc")
     said = []
     out = run_study(study, progress=False, log=said.append)
     said = "\n".join(map(str, said))
     assert "grid point 0: point-0.nc holds grid point 1: computing it again" in said
     assert "grid point 2: point-2.nc unreadable" in said
     assert "grid point 3: point-3.nc unreadable" in said
+    assert "grid point 4: point-4.nc does not match its recorded checksum" in said
     assert "resuming: 1 of 6 grid points already done" in said
     same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
-    # a part that passes the check but holds other numbers: kept on resume, not by --force
+    # --force replaces the output; the parts this run wrote are resumed, not discarded
     out.unlink()
-    _interrupted(study, 1, monkeypatch)
-    with xr.open_dataset(parts / "point-0.nc") as part:
-        tampered = part.load()
-    tampered["fraction_bounded"] = tampered.fraction_bounded * 0 + 0.5
-    write_netcdf(tampered, parts / "point-0.nc")
+    _interrupted(study, 2, monkeypatch)
+    out.write_bytes(clean.read_bytes())
     said = []
     out = run_study(study, force=True, progress=False, log=said.append)
-    assert f"--force: discarding {parts}" in said
+    assert "resuming: 2 of 6 grid points already done" in said
     same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
+
+
+def test_force_never_removes_what_stabdae_did_not_write(tmp_path):
+    """A folder at OUTPUT.parts that no stabdae run wrote (no manifest) is refused, with
+    and without --force, and left as it was; the parts of another study are discarded by
+    --force file by file (its points and manifest), leaving anything else in the folder."""
+    study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
+    parts = tmp_path / "out" / "study.nc.parts"
+    parts.mkdir(parents=True)
+    (parts / "thesis.tex").write_text("years of work")
+    (parts / "point-0.nc").write_bytes(b"a file that only looks like a part")
+    for force in (False, True):
+        with pytest.raises(FileExistsError, match=r"was not written by a stabdae run"):
+            run_study(study, force=force, progress=False, log=lambda *a: None)
+        assert sorted(p.name for p in parts.iterdir()) == ["point-0.nc", "thesis.tex"]
+    (parts / "point-0.nc").unlink()
+    other = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0, 30.0", name="other.toml")
+    from stabdae.study.run import _fingerprint
+    from stabdae.study.spec import load_study
+
+    (parts / "study.json").write_text(json.dumps(
+        {"fingerprint": _fingerprint(load_study(other)), "study": str(other)}))
+    (parts / "point-0.nc").write_bytes(b"the other study's")
+    out = run_study(study, force=True, progress=False, log=lambda *a: None)
+    assert out.is_file()
+    assert sorted(p.name for p in parts.iterdir()) == ["thesis.tex"]
+
+
+def test_the_same_study_resumes_from_another_folder(tmp_path, monkeypatch):
+    """The run key decides what a part holds, not the path the study was named by: an
+    interrupted run resumes when started again from another working folder."""
+    study = study_file(tmp_path, members=8, t_end=0.2, omegas="5.0")
+    monkeypatch.chdir(tmp_path)
+    _interrupted(Path("study.toml"), 2, monkeypatch)
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    said = []
+    out = run_study(study, progress=False, log=said.append)
+    assert "resuming: 2 of 6 grid points already done" in said and out.is_file()
 
 
 def test_a_second_run_on_the_same_output_is_refused_while_the_first_lives(tmp_path):

@@ -265,7 +265,9 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("study", help="study file (TOML)")
     run.add_argument("-o", "--output", help="NetCDF output (default: the study's [output])")
     run.add_argument("--members", type=int, help="override [ensemble] members")
-    run.add_argument("--force", action="store_true", help="overwrite an existing output")
+    run.add_argument("--force", action="store_true",
+                     help="replace an existing output (the grid points this run already "
+                     "finished are kept; another study's parts are discarded)")
     grp = run.add_mutually_exclusive_group()
     grp.add_argument("--workers", type=_positive_int, metavar="N",
                      help="start a local dask cluster of N worker processes")

@@ -3,8 +3,9 @@
 Each grid point is one :func:`stabdae.ensemble` with the study's seed (the same α⁰ targets
 at every point: common random numbers, so that differences across the grid are the
 parameters' and not the sample's).  Its dataset is written, atomically, to
-``OUT.nc.parts/point-<i>.nc`` as soon as it is done; a run that is killed and started
-again with the same command skips the points already there.  When every point is in,
+``OUT.nc.parts/point-<i>.nc`` as soon as it is done, its checksum recorded beside it; a
+run that is killed and started again with the same command (``--force`` included) skips
+the points already there.  When every point is in,
 they are combined into ``OUT.nc`` (written atomically) and the parts are removed.
 Nothing depends on where a point ran (in-process, or on dask workers), so the dataset is
 the same either way.
@@ -15,7 +16,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import shutil
 import socket
 import sys
 import time
@@ -114,19 +114,22 @@ def _fingerprint(study: Study) -> str:
     return h.hexdigest()
 
 
-def _part_ok(path: Path, index: int, stamp: str) -> str | None:
+def _part_ok(path: Path, index: int, manifest) -> str | None:
     """Why the part file of grid point ``index`` cannot be used (None when it can): it
-    must open and carry this run's key and its own grid point."""
+    must open, carry this run's key and its own grid point, and match the checksum
+    recorded when it was written."""
     try:
         with xr.open_dataset(path) as part:
             key, point = part.attrs.get("stabdae_run_key"), part.attrs.get("grid_point")
             part.load()
     except Exception as exc:  # a truncated, empty or foreign file: any reader error
         return f"unreadable ({type(exc).__name__})"
-    if key != stamp:
+    if key != manifest.fingerprint:
         return "written by another run"
     if point != index:
         return f"holds grid point {point}"
+    if not manifest.matches(path):
+        return "does not match its recorded checksum"
     return None
 
 
@@ -158,11 +161,14 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     """Run every grid point of ``study`` (a :class:`Study` or a path) and write the dataset.
 
     Returns the output path.  Raises ``FileExistsError`` when the output exists and
-    ``force`` is false.  Resumes from ``OUTPUT.parts`` when they are this study's: parts
-    written under another run key (the study file, its model or the library changed) are
-    discarded, and each part is checked before use (it opens, and carries the run key and
-    its own grid point; otherwise it is computed again).  ``OUTPUT.parts`` of another study
-    file is an error; ``force`` discards any parts and starts over.
+    ``force`` is false (``force`` replaces it).  Resumes from ``OUTPUT.parts`` when they
+    carry this run's key, from whatever folder the study is named: parts of the same study
+    file written under another key (the study file, its model or the library changed) are
+    discarded, and each part is checked before use (it opens, carries the run key and its
+    own grid point, and matches the checksum recorded when it was written; otherwise it is
+    computed again).  Parts of another study file are an error, which ``force`` turns into
+    discarding them.  Only files a stabdae run wrote are ever removed: an ``OUTPUT.parts``
+    folder without a run's manifest is refused, ``force`` or not.
     """
     if not isinstance(study, Study):
         study = load_study(study, members=members)
@@ -174,9 +180,14 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
                               "(give another output with -o)")  # fmt: skip
     parts = out.with_name(out.name + ".parts")
     stamp = _fingerprint(study)
-    manifest = parts / "study.json"
     log(study.describe())
     existed = parts.exists() and any(p.name != "lock" for p in parts.iterdir())
+    if existed and _Manifest.read(parts) is None:  # before the lock: create nothing there
+        raise FileExistsError(
+            f"{parts} exists and was not written by a stabdae run (it has no readable "
+            f"{_Manifest.NAME}); it is left as it is: move it away or give another output "
+            "with -o"
+        )
     try:
         parts.mkdir(parents=True, exist_ok=True)
         lock = _lock(parts)  # first: nothing below may remove another live run's files
@@ -186,24 +197,22 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     try:
         for orphan in out.parent.glob(f".{out.name}.*.tmp"):  # left by a killed write
             orphan.unlink(missing_ok=True)
-        if existed and force:
-            log(f"--force: discarding {parts}")
-            _clear(parts, lock)
-        elif existed:
-            try:
-                old = json.loads(manifest.read_text())
-            except (OSError, ValueError):
-                old = {}
-            if old.get("study") != str(study.path):
-                raise FileExistsError(
-                    f"{parts} holds a run of a different study "
-                    f"({old.get('study', 'unknown')}); pass --force to discard it"
-                )
-            if old.get("fingerprint") != stamp:
+        old = _Manifest.read(parts) if existed else None
+        if old is not None and old.fingerprint != stamp:
+            if old.study == str(study.path.resolve()):
                 log(f"the study file, its model or the library changed since {parts} was "
                     "written: starting over")  # fmt: skip
-                _clear(parts, lock)
-        return _run_locked(study, out, parts, stamp, manifest, workers, scheduler, progress,
+            elif force:
+                log(f"--force: discarding the parts of {old.study} in {parts}")
+            else:
+                raise FileExistsError(
+                    f"{parts} holds a run of a different study ({old.study}); pass --force "
+                    "to discard it"
+                )
+            _clear(parts)
+            old = None
+        manifest = old or _Manifest(parts, stamp, str(study.path.resolve()))
+        return _run_locked(study, out, parts, manifest, workers, scheduler, progress,
                            threads, log)  # fmt: skip
     finally:
         lock.unlink(missing_ok=True)
@@ -211,10 +220,60 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
             parts.rmdir()
 
 
-def _clear(parts: Path, keep: Path) -> None:
-    for path in parts.iterdir():
-        if path != keep:
-            shutil.rmtree(path) if path.is_dir() else path.unlink()
+class _Manifest:
+    """``OUTPUT.parts/study.json``: the run key, the study file (resolved) and the SHA-256
+    of every part as it was written, so that a part altered afterwards is computed again.
+    Only the process that runs the study writes it (dask workers return datasets)."""
+
+    NAME = "study.json"
+
+    def __init__(self, parts: Path, fingerprint: str, study: str, digests=None):
+        self.parts, self.fingerprint, self.study = parts, fingerprint, study
+        self.digests = dict(digests or {})
+
+    @classmethod
+    def read(cls, parts: Path):
+        """The manifest in ``parts``, or None when there is none a stabdae run wrote."""
+        try:
+            raw = json.loads((parts / cls.NAME).read_text())
+            return cls(parts, str(raw["fingerprint"]), str(raw["study"]),
+                       {str(k): str(v) for k, v in raw.get("parts", {}).items()})  # fmt: skip
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return None
+
+    def save(self) -> None:
+        text = json.dumps({"fingerprint": self.fingerprint, "study": self.study,
+                           "parts": self.digests}, sort_keys=True)  # fmt: skip
+        tmp = self.parts / f".{self.NAME}.tmp"
+        tmp.write_text(text)
+        os.replace(tmp, self.parts / self.NAME)  # a kill leaves the old or the new one
+
+    def write(self, ds: xr.Dataset, index: int) -> None:
+        """Write grid point ``index``'s part and record its checksum."""
+        path = self.parts / f"point-{index}.nc"
+        write_netcdf(_keyed(ds, index, self.fingerprint), path)
+        self.digests[path.name] = _sha256(path)
+        self.save()
+
+    def matches(self, path: Path) -> bool:
+        return self.digests.get(path.name) == _sha256(path)
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _clear(parts: Path) -> None:
+    """Remove what stabdae wrote in ``parts`` (its points, manifest and temporary files),
+    nothing else."""
+    for pattern in ("point-*.nc", _Manifest.NAME, ".point-*.tmp", f".{_Manifest.NAME}.tmp"):
+        for path in parts.glob(pattern):
+            if path.is_file():
+                path.unlink()
 
 
 def _lock(parts: Path) -> Path:
@@ -252,16 +311,15 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def _run_locked(study, out, parts, stamp, manifest, workers, scheduler, progress, threads,
+def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threads,
                 log) -> Path:  # fmt: skip
-    manifest.write_text(json.dumps({"fingerprint": stamp, "study": str(study.path)}))
-
+    manifest.save()
     points = list(study.points())
     todo = []
     for i, (_, values) in enumerate(points):
         part = parts / f"point-{i}.nc"
         if part.exists():
-            why = _part_ok(part, i, stamp)
+            why = _part_ok(part, i, manifest)
             if why is None:
                 continue
             log(f"grid point {i}: {part.name} {why}: computing it again")
@@ -273,12 +331,11 @@ def _run_locked(study, out, parts, stamp, manifest, workers, scheduler, progress
     bar = _Progress(len(points), len(points) - len(todo), study.ensemble["members"], progress)
     try:
         if workers or scheduler:
-            _run_dask(study, todo, parts, workers, scheduler, bar, stamp)
+            _run_dask(study, todo, manifest, workers, scheduler, bar)
         else:
             for i, values in todo:
                 report = bar.note if study.search is not None else bar.members
-                ds = run_point(study, values, threads=threads, progress=report)
-                write_netcdf(_keyed(ds, i, stamp), parts / f"point-{i}.nc")
+                manifest.write(run_point(study, values, threads=threads, progress=report), i)
                 bar.point_done()
     finally:
         bar.close()
@@ -287,7 +344,7 @@ def _run_locked(study, out, parts, stamp, manifest, workers, scheduler, progress
         ds = _with_path_theory(study, ds)
     ds.attrs["wall_run_s"] = time.perf_counter() - start
     write_netcdf(ds, out)
-    shutil.rmtree(parts)
+    _clear(parts)
     log(summary(ds))
     log(f"dataset written to {out}")
     return out
@@ -309,7 +366,7 @@ def _keyed(ds: xr.Dataset, index: int, stamp: str) -> xr.Dataset:
     return ds
 
 
-def _run_dask(study, todo, parts, workers, scheduler, bar, stamp):
+def _run_dask(study, todo, manifest, workers, scheduler, bar):
     from dask.distributed import Client, LocalCluster, as_completed
 
     if scheduler:
@@ -329,7 +386,7 @@ def _run_dask(study, todo, parts, workers, scheduler, bar, stamp):
                    for i, values in todo}  # fmt: skip
         for fut in as_completed(futures):
             i = futures[fut]
-            write_netcdf(_keyed(fut.result(), i, stamp), parts / f"point-{i}.nc")
+            manifest.write(fut.result(), i)
             bar.point_done()
     finally:
         client.close()
