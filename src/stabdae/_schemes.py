@@ -108,9 +108,20 @@ class Scheme:
 
     def attrs(self) -> dict:
         out = {"scheme": self.name, "scheme_order": self.order, **self.params}
-        if self.name not in _BY_NAME and self.name != "two_stage":  # a user's tableau
+        if not self._builtin():  # a user's tableau: the name alone does not say what it is
             out.update(scheme_A=self.A.ravel(), scheme_b=self.b, scheme_c=self.c)
         return out
+
+    def _builtin(self) -> bool:
+        """Is this the built-in scheme its name says (the same coefficients)?"""
+        if self.name == "two_stage" and {"a", "sigma"} <= set(self.params):
+            with warnings.catch_warnings():  # its first-order warning was given already
+                warnings.simplefilter("ignore", UserWarning)
+                ref = two_stage(self.params["a"], self.params["sigma"])
+        else:
+            ref = _BY_NAME[self.name]() if self.name in _BY_NAME else None
+        return ref is not None and all(np.array_equal(getattr(self, k), getattr(ref, k))
+                                       for k in ("A", "b", "c"))  # fmt: skip
 
     def __repr__(self) -> str:
         extra = "".join(f", {k}={v}" for k, v in self.params.items())
@@ -449,13 +460,23 @@ def from_tableau(spec: dict, name: str = "custom") -> Scheme:
     missing = [k for k in ("A", "b", "c", "order") if k not in spec]
     if missing:
         raise SchemeError(f"a tableau needs A, b, c and order; missing {missing}")
+    for key in spec:
+        if key not in ("A", "b", "c", "order", "name"):
+            hint = " (they belong to the two-stage family, 'two_stage')" \
+                if key in ("a", "sigma") else ""  # fmt: skip
+            raise SchemeError(f"a tableau is its A, b and c: {key!r} would change "
+                              f"nothing{hint}")  # fmt: skip
+    label = str(spec.get("name", name))
+    if label.lower() in _BY_NAME or label.lower() == "two_stage":
+        raise SchemeError(f"{label.lower()!r} is the name of a built-in scheme; give your "
+                          "tableau a name of its own")  # fmt: skip
     try:
         A = np.array(spec["A"], dtype=float)
         b = np.array(spec["b"], dtype=float)
         c = np.array(spec["c"], dtype=float)
     except (TypeError, ValueError):
         raise SchemeError("a tableau's A, b and c must be arrays of numbers") from None
-    return Scheme(str(spec.get("name", name)), A, b, c, int(spec["order"]), {})
+    return Scheme(label, A, b, c, int(spec["order"]), {})
 
 
 def as_scheme(scheme, **params) -> Scheme:

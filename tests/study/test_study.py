@@ -261,6 +261,19 @@ def test_a_tableau_in_the_study_file(tmp_path):
     wrong = text.replace("order = 3", "order = 4")
     with pytest.raises(StudyError, match=r"\[scheme\] name: .*declared order 4"):
         load_study(write(tmp_path, wrong, "wrong.toml"))
+    # a and sigma belong to the two-stage family: beside a tableau, given or swept, they
+    # would change nothing
+    with pytest.raises(StudyError, match=r"\[scheme\].*a tableau is its A, b and c: 'a' "):
+        load_study(write(tmp_path, text.replace("order = 3", "order = 3\na = 0.3"), "a.toml"))
+    with pytest.raises(StudyError, match=r"a tableau is its A, b and c: 'sigma' "):
+        load_study(write(tmp_path, text + "\n[sweep]\nsigma = [1.0, 2.0]\n", "s.toml"))
+    # a tableau named like a built-in scheme would be recorded (and its theory computed) as
+    # that scheme
+    with pytest.raises(StudyError, match=r"'rk4' is the name of a built-in scheme"):
+        load_study(write(tmp_path, text.replace('"my_kutta"', '"RK4"'), "rk4.toml"))
+    posing = stabdae.Scheme("rk4", scheme.A, scheme.b, scheme.c, 3, {})
+    np.testing.assert_array_equal(posing.attrs()["scheme_b"], stabdae.rk3().b)
+    assert "scheme_b" not in stabdae.rk4().attrs()
 
 
 def test_moved_tau_values_are_reported(tmp_path, capsys):

@@ -61,7 +61,7 @@ def for_study(study, *, path_steps: int = 2000) -> xr.Dataset:
             A = law.A_tilde(model)
             # what depends on Ã (and the scheme) alone is computed once per distinct law,
             # not at every τ of the grid: the τ limits are four bisections each
-            key = (A.tobytes(), A.shape, scheme.name, tuple(sorted(scheme.params.items())))
+            key = (A.tobytes(), A.shape, scheme.stability_polynomial().tobytes())
             if key not in per_law:
                 c, ly = continuous(A), lyapunov(A)
                 per_law[key] = {
