@@ -7,6 +7,7 @@ import hashlib
 import importlib.util
 import keyword
 import sys
+import types
 from pathlib import Path
 
 from ._model import Model, ModelError
@@ -127,9 +128,17 @@ def load_model(source, attribute: str = "model") -> Model:
     """
     path = model_file(source)
     name = module_name(path)
-    if name in sys.modules:
-        module = sys.modules[name]
-    else:
+    module = sys.modules.get(name)
+    stamp = getattr(module, "__stabdae_sources__", None)
+    if module is not None and stamp is not None and _sources_changed(stamp):
+        # edited since it was loaded (a notebook): load it, and the helper modules it
+        # reads that were edited or import one that was, afresh
+        for dep in stamp:
+            if dep[0] != name:
+                sys.modules.pop(dep[0], None)
+        del sys.modules[name]
+        module = None
+    if module is None:
         spec = importlib.util.spec_from_file_location(name, path)
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
@@ -142,6 +151,9 @@ def load_model(source, attribute: str = "model") -> Model:
         except BaseException:
             del sys.modules[name]
             raise
+        module.__stabdae_sources__ = _sources(module)
+    elif stamp is None:  # imported before stabdae saw it: watched from now on
+        module.__stabdae_sources__ = _sources(module)
     model = getattr(module, attribute, None)
     if not isinstance(model, Model):
         raise ModelError(
@@ -149,3 +161,51 @@ def load_model(source, attribute: str = "model") -> Model:
             f"{attribute!r}; found {type(model).__name__}"
         )
     return model
+
+
+def _sources(module) -> tuple:
+    """``(module name, file, SHA-256)`` of the model's module and of every module of the
+    user's that it reads, directly or through the functions and modules it reads (helpers
+    wherever they live; the library's modules and installed packages left out)."""
+    out, todo, seen = [], [module], set()
+    while todo:
+        mod = todo.pop()
+        if id(mod) in seen:
+            continue
+        seen.add(id(mod))
+        file = _origin(getattr(mod, "__file__", None))
+        if file is None or not file.is_file():
+            continue
+        out.append((mod.__name__, str(file), _sha256(file)))
+        for value in list(vars(mod).values()):
+            dep = value if isinstance(value, types.ModuleType) else \
+                sys.modules.get(getattr(getattr(value, "py_func", value), "__module__", None)
+                                or "")  # fmt: skip
+            if dep is not None and _user_module(dep):
+                todo.append(dep)
+    return tuple(out)
+
+
+def _user_module(module) -> bool:
+    name = getattr(module, "__name__", "") or ""
+    if name.split(".")[0] in ("stabdae", "numba", "numpy", "scipy", "math", "builtins"):
+        return False
+    file = _origin(getattr(module, "__file__", None))
+    if file is None:
+        return False
+    prefixes = {Path(p).resolve() for p in (sys.prefix, sys.base_prefix, sys.exec_prefix)}
+    return not any(file.is_relative_to(p) for p in prefixes)
+
+
+def _sources_changed(stamp) -> bool:
+    for _, file, digest in stamp:
+        try:
+            if _sha256(Path(file)) != digest:
+                return True
+        except OSError:
+            return True
+    return False
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()

@@ -154,6 +154,7 @@ import os
 import numpy as np
 from numba import njit
 import stabdae
+import consts_mod
 from helper_mod import radial_accel
 
 G = float(os.environ.get("STABDAE_TEST_G", "9.81"))  # read when the file is loaded
@@ -162,7 +163,7 @@ G = float(os.environ.get("STABDAE_TEST_G", "9.81"))  # read when the file is loa
 @njit
 def forces(t, q, v, p, out):
     out[0] = 0.0
-    out[1] = G
+    out[1] = G * consts_mod.SCALE
 
 
 @njit
@@ -228,6 +229,7 @@ def model_folder(tmp_path):
     folder.mkdir()
     (folder / "global_pendulum.py").write_text(MODEL_WITH_GLOBAL)
     (folder / "helper_mod.py").write_text(HELPER)
+    (folder / "consts_mod.py").write_text("SCALE = 1.0\n")
     return folder / "global_pendulum.py"
 
 
@@ -243,6 +245,32 @@ def test_a_global_read_at_run_time_and_an_edited_helper_are_in_the_key(model_fol
     helper.write_text(HELPER.replace("2.0 * (", "2.0 * 1.5 * ("))  # a different f_accel
     edited = _run_model(model_folder, cache)
     assert edited["x"] == _run_model(model_folder, "off")["x"] != earth["x"]
+    # a module attribute the model reads (consts_mod.SCALE): its value is in the key
+    (model_folder.parent / "consts_mod.py").write_text("SCALE = 1.25\n")
+    assert _run_model(model_folder, cache)["x"] != edited["x"]
+
+
+def test_the_values_of_module_attributes_a_function_reads_are_in_its_key():
+    """``consts.G`` inside a model function is frozen into the compiled code like a
+    global: the function's key holds the attribute's value, and a nested module's too."""
+    import types
+
+    consts = types.ModuleType("stabdae_test_consts")
+    consts.inner = types.ModuleType("stabdae_test_consts.inner")
+    consts.G, consts.inner.K, consts.unused = 9.81, 2.0, 1.0
+
+    def forces(t, q, v, p, out):
+        out[0] = consts.G * consts.inner.K
+
+    first = function_fingerprint(forces)
+    consts.unused = 5.0  # not read: the key stays
+    assert function_fingerprint(forces) == first
+    consts.G = 1.62
+    moon = function_fingerprint(forces)
+    consts.inner.K = 3.0
+    assert len({first, moon, function_fingerprint(forces)}) == 3
+    consts.inner.K = object()  # a value without a fingerprint: no key, not a wrong one
+    assert function_fingerprint(forces) is None
 
 
 def test_an_unregistered_module_runs_twice_in_a_fresh_cache(model_folder, tmp_path):
@@ -341,3 +369,21 @@ def test_a_cached_model_file_loads_and_imports_under_one_name(tmp_path):
     assert run(LOAD, model_file) == "pendulum ['pendulum_cached']"
     assert run(IMPORT_PLAIN, tmp_path) == "pendulum pendulum_cached"
     assert run(LOAD, model_file) == "pendulum ['pendulum_cached']"
+
+
+def test_load_model_sees_an_edited_file_and_an_edited_helper(model_folder, monkeypatch):
+    """In one process (a notebook): editing the model file, or a helper module it reads,
+    and calling load_model again gives the edited model, not the one loaded before; an
+    unedited file gives the same model object."""
+    monkeypatch.syspath_prepend(str(model_folder.parent))
+    first = stabdae.load_model(model_folder)
+    assert stabdae.load_model(model_folder) is first
+    model_folder.write_text(MODEL_WITH_GLOBAL.replace('"global_pendulum"', '"edited"'))
+    edited = stabdae.load_model(model_folder)
+    assert edited.name == "edited"
+    consts = model_folder.parent / "consts_mod.py"
+    consts.write_text("SCALE = 2.0\n")
+    again = stabdae.load_model(model_folder)
+    assert again is not edited
+    forces = again.functions["forces"]
+    assert forces.py_func.__globals__["consts_mod"].SCALE == 2.0

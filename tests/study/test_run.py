@@ -241,6 +241,37 @@ def test_resume_after_a_model_edit_recomputes_and_equals_a_clean_run(tmp_path, m
     same_data(got, xr.open_dataset(clean / "out" / "study.nc").load())
 
 
+def test_the_run_key_covers_helpers_outside_the_model_folder(tmp_path, monkeypatch):
+    """A model function that calls a helper from a module outside the model's folder (on
+    sys.path), or reads a value from one: editing the helper changes the run key, so
+    parts of the old helper are never mixed in."""
+    from stabdae.study.run import _fingerprint
+    from stabdae.study.spec import load_study
+
+    lib = tmp_path / "shared_lib"
+    lib.mkdir()
+    (lib / "pend_helpers_x.py").write_text("from numba import njit\nSCALE = 1.0\n\n\n"
+                                           "@njit\ndef gravity(g):\n    return g\n")
+    monkeypatch.syspath_prepend(str(lib))
+    models = tmp_path / "models"
+    models.mkdir()
+    source = (ROOT / "kernels" / "pendulum.py").read_text()
+    assert "out[1] = p[0]" in source  # the pendulum's gravity, replaced below
+    source = "import pend_helpers_x\n" + source.replace(
+        "out[1] = p[0]", "out[1] = pend_helpers_x.gravity(p[0]) * pend_helpers_x.SCALE")
+    (models / "pend_x.py").write_text(source)
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.format(members=16, t_end=0.2, omegas="5.0").replace(
+        'file = "pendulum"', 'file = "models/pend_x.py"'))
+    keys = [_fingerprint(load_study(study))]
+    helper = lib / "pend_helpers_x.py"
+    helper.write_text(helper.read_text().replace("return g", "return 0.5 * g"))
+    keys.append(_fingerprint(load_study(study)))
+    helper.write_text(helper.read_text().replace("SCALE = 1.0", "SCALE = 2.0"))
+    keys.append(_fingerprint(load_study(study)))
+    assert len(set(keys)) == 3
+
+
 def test_bad_parts_are_computed_again_and_force_keeps_good_ones(tmp_path, monkeypatch):
     """Each part is checked before it is used: a part of another grid point, a truncated,
     an empty and an altered part (its checksum differs from the one recorded when it was

@@ -7,15 +7,16 @@ repeats and the cache never hits.  Here a kernel gets an explicit key instead:
 
 * the library: the text of every stabdae module and numba's version;
 * the model: for each of its functions the qualified name and the SHA-256 of the source
-  file that defines it (so editing a model file, or any function in it, recompiles), and
-  the sizes ``n, m, k``;
+  file that defines it (so editing a model file, or any function in it, recompiles), the
+  values of what it closes over, of the globals and module attributes it reads (numba
+  freezes them into the code), the same for every function it calls wherever that lives,
+  and the sizes ``n, m, k``;
 * the kernel's own compile-time choices, one :class:`Spec` per factory (law kind, user law
   function, scheme pattern, block, …): the same object is the memo key on the model.
 
-Functions defined without a source file (an interactive session) have no fingerprint;
-their kernels are compiled as before and not cached.  A change in a helper function that a
-model function calls *from another file* is not seen (as with numba's own cache): clear the
-cache (:func:`clear`) after editing such a helper.
+Functions defined without a source file (an interactive session), or reading a value that
+has none (an arbitrary object), have no fingerprint; their kernels are compiled as before
+and not cached.
 
 The cache lives in ``$STABDAE_CACHE_DIR``, else ``$NUMBA_CACHE_DIR/stabdae``, else
 ``~/.cache/stabdae`` (``$XDG_CACHE_HOME`` honoured); ``STABDAE_CACHE_DIR=off`` disables it.
@@ -161,17 +162,18 @@ def function_fingerprint(fn, _seen=None) -> str | None:
     seen.add(id(py_func))
     out = (f"{py_func.__module__}.{py_func.__qualname__}:{code.co_firstlineno}"
            f"@{_file_digest(path, st.st_mtime, st.st_size)}")  # fmt: skip
+    reads = _global_names(code)  # globals and attribute names alike
     cells = []
     for cell in py_func.__closure__ or ():
-        value = _value_fingerprint(cell.cell_contents, seen)
+        value = _value_fingerprint(cell.cell_contents, seen, reads)
         if value is None:
             return None
         cells.append(value)
     names = []
-    for name in sorted(_global_names(code)):
+    for name in sorted(reads):
         if name not in py_func.__globals__:
             continue  # a builtin, or an attribute name
-        value = _value_fingerprint(py_func.__globals__[name], seen)
+        value = _value_fingerprint(py_func.__globals__[name], seen, reads)
         if value is None:
             return None
         names.append(f"{name}={value}")
@@ -191,7 +193,7 @@ def _global_names(code) -> set[str]:
 _LIBRARY_MODULES = ("math", "cmath", "numpy", "numba", "scipy", "stabdae", "builtins")
 
 
-def _value_fingerprint(value, seen=None) -> str | None:
+def _value_fingerprint(value, seen=None, reads=frozenset()) -> str | None:
     if value is None or isinstance(value, (bool, int, float, complex, str, bytes)):
         return f"{type(value).__name__}:{value!r}"
     if isinstance(value, np.ndarray):
@@ -203,7 +205,7 @@ def _value_fingerprint(value, seen=None) -> str | None:
         parts = [_value_fingerprint(v, seen) for v in value]
         return None if None in parts else f"({','.join(parts)})"
     if isinstance(value, types.ModuleType):
-        return f"module:{value.__name__}"
+        return _module_fingerprint(value, seen, reads)
     module = getattr(value, "__module__", None) or ""
     if callable(value) and module.split(".")[0] in _LIBRARY_MODULES:
         return f"function:{module}.{getattr(value, '__qualname__', repr(value))}"
@@ -212,6 +214,29 @@ def _value_fingerprint(value, seen=None) -> str | None:
     if callable(value):
         return function_fingerprint(value, seen)
     return None
+
+
+def _module_fingerprint(module, seen, reads) -> str | None:
+    """A module a function reads attributes of (``consts.G``): numba freezes those values
+    into the compiled code like globals, so the attributes named in the function's code
+    are keyed by value (modules of the library by name).  ``reads`` holds every name the
+    code uses; those that are not the module's attributes are left out."""
+    name = getattr(module, "__name__", "?")
+    if name.split(".")[0] in _LIBRARY_MODULES:
+        return f"module:{name}"
+    seen = set() if seen is None else seen
+    if id(module) in seen:  # modules that import each other
+        return f"module:{name}"
+    seen.add(id(module))
+    attrs = []
+    for attr in sorted(reads):
+        if attr in vars(module):
+            value = _value_fingerprint(vars(module)[attr], seen, reads)
+            if value is None:
+                return None
+            attrs.append(f"{attr}={value}")
+    seen.discard(id(module))  # read again through another path: keyed again
+    return f"module:{name}" + (f"{{{','.join(attrs)}}}" if attrs else "")
 
 
 def fingerprint(*parts) -> str | None:

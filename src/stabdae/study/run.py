@@ -31,7 +31,7 @@ from .._integrate import IntegrationWarning
 from .._loading import local_imports
 from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
-from ..engine.cache import library_fingerprint
+from ..engine.cache import function_fingerprint, library_fingerprint
 from .report import summary
 from .spec import Study, StudyError, load_study
 from .theory import axis_units, for_study
@@ -102,7 +102,8 @@ def search_point(study: Study, s: dict, threads=None, progress=None) -> xr.Datas
 def _fingerprint(study: Study) -> str:
     """The run key: everything that decides a grid point's numbers — the study file (its
     parameters, law, scheme, run and grid), the ensemble settings as run (``--members``),
-    the model file and the modules of its folder that it imports, and the library (its
+    the model file and the modules of its folder that it imports, the model's functions
+    with the helpers and values they read (wherever those live), and the library (its
     source, numba's version, FMA)."""
     h = hashlib.sha256(study.path.read_bytes())
     h.update(json.dumps(study.ensemble, sort_keys=True).encode())
@@ -111,6 +112,11 @@ def _fingerprint(study: Study) -> str:
     if study.model_file is not None:
         for path in local_imports(study.model_file):
             h.update(path.name.encode() + b"\0" + path.read_bytes())
+    # the model's functions as the kernels are keyed: helpers they call wherever those
+    # live, and the values of the globals and module attributes they read
+    model = study.model
+    for piece, fn in sorted({**model.functions, "energy": model.energy}.items()):
+        h.update(f"{piece}={function_fingerprint(fn) if fn is not None else None}".encode())
     return h.hexdigest()
 
 
