@@ -204,7 +204,9 @@ def ensemble(
         ``steps_accepted`` and ``rhs_evaluations`` per member, and only the
         continuous-time prediction ``beta_theory``.
     members : int
-        Ensemble size (ignored when ``x0`` is given).
+        Ensemble size (ignored when ``x0`` is given).  An ensemble whose estimated memory
+        (about ``8 (8n + 4(2m + k) + 48)`` bytes per member, plus the traces) exceeds the
+        memory available is refused with the figures before anything is allocated.
     radius : float or (low, high)
         Range of ``‖α⁰‖∞``, log-uniform; directions uniform.
     seed : int
@@ -481,6 +483,14 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
     else:
         x0 = check.initial_states(model, x0, who)
         members = x0.shape[0]
+    samples = save_times.size + 1 if adaptive else nsteps // save_every + 1
+    traced_count = members if traces == "all" else 0 if traces == "none" else \
+        min(traces, members) if isinstance(traces, (int, np.integer)) else 0  # fmt: skip
+    check.fits_in_memory(
+        check.ensemble_bytes(model.n, model.n_residual, members, traced_count, samples,
+                             np.dtype(rdtype).itemsize),
+        f"members = {members} with {traced_count} traces of {samples} samples", who,
+        "run fewer members (several ensembles with other seeds), or store fewer traces")
     trace_row, traced = _trace_rows(traces, members, who)
     if not isinstance(states, (bool, np.bool_)):
         raise TypeError(f"{who}: states must be True or False, got {states!r}")

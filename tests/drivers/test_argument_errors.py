@@ -71,3 +71,32 @@ def test_every_argument_error_names_the_function_called(index):
 def test_tau_limit_names_an_unknown_condition():
     with pytest.raises(ValueError, match=r"tau_limit: condition must be one of .*'spectral'"):
         theory.tau_limit(np.array([[-1.0]]), "euler", condition="spectal")
+
+
+def test_an_ensemble_too_large_for_memory_is_refused_up_front(monkeypatch):
+    """An ensemble that cannot fit is refused with its figures before anything is allocated
+    or compiled (the operating system would kill the process part-way instead); the
+    estimate is the documented per-member budget, checked here against a small budget."""
+    from stabdae import _validate
+
+    model = pendulum_scene()
+    with pytest.raises(MemoryError, match=r"ensemble: members = 1000000000000 with 64 "
+                                          r"traces of 11 samples needs about [\d.]+e\+05 "
+                                          r"GiB, more than the"):
+        stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 0.1, 1.0,
+                         members=10**12, save_dt=0.1)  # fmt: skip
+    need = _validate.ensemble_bytes(model.n, model.n_residual, 1000, 1000, 11, 4)
+    assert need == 8 * (8 * 2 + 4 * 2 + 48) * 1000 + 2 * 4 * 1000 * 11
+    monkeypatch.setattr(_validate, "available_memory", lambda: need - 1)
+    with pytest.raises(MemoryError, match="run fewer members"):
+        stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 0.1, 1.0, members=1000,
+                         save_dt=0.1, traces="all")  # fmt: skip
+
+
+def test_a_study_with_too_many_members_is_refused_when_loaded(tmp_path):
+    from conftest import study_file
+    from stabdae.study.spec import StudyError, load_study
+
+    with pytest.raises(StudyError, match=r"\[ensemble\] members: 1000000000000 members per "
+                                         r"grid point needs about .* GiB"):
+        load_study(study_file(tmp_path), members=10**12)

@@ -24,7 +24,7 @@ from .._laws import Law, LawError, baumgarte, matrix, none, theorem5
 from .._loading import load_model, model_file
 from .._model import Model, ModelError
 from .._schemes import Scheme, SchemeError, as_scheme, from_tableau
-from .._validate import block, fixed_time_grid
+from .._validate import block, ensemble_bytes, fits_in_memory, fixed_time_grid
 
 __all__ = ["Study", "StudyError", "load_study"]
 
@@ -267,6 +267,12 @@ def load_study(path, *, members: int | None = None) -> Study:
         ens["members"] = members
     if ens["members"] < 1:
         fail("[ensemble] members", f"must be at least 1, got {ens['members']}")
+    try:  # before any grid point: refused up front, not killed part-way
+        fits_in_memory(ensemble_bytes(model.n, model.n_residual, ens["members"], 0, 0, 4),
+                       f"{ens['members']} members per grid point", "load_study",
+                       "run fewer members")  # fmt: skip
+    except MemoryError as exc:
+        fail("[ensemble] members", str(exc).removeprefix("load_study: "))
     radius = ens["radius"]
     radius = [radius, radius] if isinstance(radius, float) else radius
     if len(radius) != 2 or not all(isinstance(r, (int, float)) for r in radius):
