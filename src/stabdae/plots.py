@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ._version import __version__
+
 __all__ = ["plot_dataset", "stability_map", "decay_curves", "beta_comparison",
            "boundary_curve"]
 
@@ -289,13 +291,25 @@ def plot_dataset(dataset, output=None) -> list[Path]:
         out = Path(output)
         stem = out / (src.stem if src else "stabdae") if out.is_dir() else out.with_suffix("")
     stem.parent.mkdir(parents=True, exist_ok=True)
-    if "tau_star" in ds:
-        return [boundary_curve(ds, Path(f"{stem}_boundary.png"))]
-    return [
-        stability_map(ds, Path(f"{stem}_stability.png")),
-        decay_curves(ds, Path(f"{stem}_decay.png")),
-        beta_comparison(ds, Path(f"{stem}_beta.png")),
-    ]
+    try:
+        if "tau_star" in ds:
+            return [boundary_curve(ds, Path(f"{stem}_boundary.png"))]
+        return [
+            stability_map(ds, Path(f"{stem}_stability.png")),
+            decay_curves(ds, Path(f"{stem}_decay.png")),
+            beta_comparison(ds, Path(f"{stem}_beta.png")),
+        ]
+    except (KeyError, AttributeError, IndexError, ValueError) as exc:
+        written = str(ds.attrs.get("stabdae_version", "an unknown version"))
+        if written == __version__:
+            raise  # this version's own dataset: a defect to see in full
+        what = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        raise ValueError(
+            f"stabdae plot: {src or 'the dataset'} was written by stabdae {written}; "
+            f"stabdae {__version__} plots what it writes itself and cannot draw this one "
+            f"(missing or different: {what!r}); plot it with stabdae {written}, or run its "
+            "study again with this version"
+        ) from None
 
 
 def boundary_curve(ds: xr.Dataset, path: Path) -> Path:

@@ -166,3 +166,28 @@ def test_progress_says_compiling_until_the_kernels_are_ready(tmp_path, capsys):
     assert err.index("stabdae run (compiling)") < err.index("kernels ready in")
     compiling = err[: err.index("kernels ready in")]
     assert " 0/48 " in compiling and "?" in compiling  # no rate, no time left guessed
+
+
+def test_plot_refuses_an_older_dataset_in_one_line(tmp_path, capsys):
+    """A dataset written by an earlier version, without a variable this version's pictures
+    read: one line that names both versions and what is missing, exit 2, no traceback;
+    the same dataset with the variable plots."""
+    import pytest
+
+    import stabdae
+    from conftest import pendulum_scene
+    from stabdae._schema import write_netcdf
+
+    ds = stabdae.ensemble(pendulum_scene(), stabdae.baumgarte(10.0), "midpoint", 0.01, 0.5,
+                          members=16, seed=1)  # fmt: skip
+    old = ds.drop_vars("residual_norm")
+    old.attrs["stabdae_version"] = "0.0.1"
+    write_netcdf(old, tmp_path / "old.nc")
+    assert main(["plot", str(tmp_path / "old.nc")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert f"written by stabdae 0.0.1; stabdae {stabdae.__version__} plots what" in err
+    assert "'residual_norm'" in err
+    pytest.importorskip("matplotlib")
+    write_netcdf(ds, tmp_path / "new.nc")
+    assert main(["plot", str(tmp_path / "new.nc")]) == 0
