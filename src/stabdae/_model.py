@@ -510,6 +510,22 @@ class Model:
                     f"out{list(i)} = {outputs[piece][i]!r} at the reference state, an "
                     "entry its declared sparsity pattern marks structurally zero"
                 )
+            # a structural zero holds everywhere: the states the detection visits too (a
+            # kernel built on a wrong pattern drops a term and runs on without a word)
+            seen = self._detect_states(x_ref)
+            for t, x in zip(*seen):
+                with np.errstate(all="ignore"):
+                    value = self.evaluate(piece, t, x, p)
+                outside = (value != 0) & ~pattern
+                if outside.any():
+                    i = tuple(int(j) for j in np.argwhere(outside)[0])
+                    raise ModelError(
+                        f"Model {self.name!r}: {_call_signature(piece)} writes "
+                        f"out{list(i)} = {float(value[i])!r} at t = {t:g}, x = "
+                        f"{np.array2string(x, precision=6, max_line_width=10**6)}, an entry its "
+                        "declared sparsity pattern marks structurally zero (it must be zero "
+                        "at every state)"
+                    )
             patterns[piece] = pattern
         self._declared = tuple(declared)
         return patterns
@@ -518,13 +534,7 @@ class Model:
         """An entry is structurally zero when it is exactly zero at the reference state
         and at ``states`` random states around it (displaced by 1e-3 and 0.3 of each
         coordinate's scale, at random times when the model depends on time)."""
-        rng = np.random.default_rng(seed)
-        scale = np.maximum(1.0, np.abs(x_ref))
-        xs, ts = [x_ref], [self.t0]
-        for i in range(states):
-            radius = 1e-3 if i % 2 == 0 else 0.3
-            xs.append(x_ref + radius * scale * rng.standard_normal(x_ref.shape))
-            ts.append(self.t0 + (rng.uniform(0.0, 1.0) if self.time_dependent else 0.0))
+        ts, xs = self._detect_states(x_ref, states, seed)
         patterns = {}
         for piece in _PATTERNED:
             if piece not in self.functions:
@@ -536,6 +546,18 @@ class Model:
                 pattern = nz if pattern is None else pattern | nz
             patterns[piece] = pattern
         return patterns
+
+    def _detect_states(self, x_ref, states: int = 4, seed: int = 0):
+        """``(times, states)`` of the detection: the reference state and ``states`` random
+        ones around it (displaced by 1e-3 and 0.3 of each coordinate's scale, in turn)."""
+        rng = np.random.default_rng(seed)
+        scale = np.maximum(1.0, np.abs(x_ref))
+        xs, ts = [x_ref], [self.t0]
+        for i in range(states):
+            radius = 1e-3 if i % 2 == 0 else 0.3
+            xs.append(x_ref + radius * scale * rng.standard_normal(x_ref.shape))
+            ts.append(self.t0 + (rng.uniform(0.0, 1.0) if self.time_dependent else 0.0))
+        return ts, xs
 
     def sparse_structure(self):
         """The index lists of the sparse right-hand side (:mod:`stabdae.engine.sparsity`),

@@ -218,10 +218,20 @@ def test_detection_sees_entries_that_vanish_at_the_reference_state():
     assert _bead(sparsity="dense").patterns is None
 
 
-def test_a_wrongly_declared_pattern_is_caught_by_check():
-    """An entry declared structurally zero that is zero at the reference state only: the
-    model is built, and check() names the function and the entry."""
+def test_a_wrongly_declared_pattern_is_refused_and_caught_by_check(monkeypatch):
+    """An entry declared structurally zero that is zero at the reference state only (a
+    kernel built on it would drop the term and run on): Model() refuses it, naming the
+    function, the entry and the state where it is not zero; and check(), at its own
+    states, names it too."""
     wrong = np.array([[True, True, False], [False, False, True]])  # misses ∂f₁/∂x
+    with pytest.raises(stabdae.ModelError, match=r"f_q\(t, q, p, out\) writes out\[1, 0\] = "
+                                                 r"\S+ at t = 0, x = \[.*\], an entry its "
+                                                 r"declared sparsity pattern"):  # fmt: skip
+        _bead(sparsity={"f_q": wrong})
+    # check() judges the pattern on states of its own (here with construction's states
+    # reduced to the reference one, where the wrong entry happens to be zero)
+    monkeypatch.setattr(stabdae.Model, "_detect_states",
+                        lambda self, x_ref, states=4, seed=0: ([self.t0], [x_ref]))
     model = _bead(sparsity={"f_q": wrong})
     np.testing.assert_array_equal(model.patterns["f_q"], wrong)
     report = model.check()
