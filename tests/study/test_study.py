@@ -320,6 +320,35 @@ def test_shipped_theorem5_study_runs_with_more_members_than_traces(monkeypatch):
         assert held.dims == ("trace",) and set(np.unique(held.values)) <= {0, 1}
 
 
+
+def test_a_study_runs_model_code_only_from_its_own_folder(tmp_path, capsys):
+    """A study file is data and a model file is code: a model outside the study's folder
+    (by path or through a link inside it) is refused, naming the path and the option; a
+    model below the folder, a built-in scene, and --trust-model are accepted."""
+    pend = (Path(__file__).resolve().parents[2] / "kernels" / "pendulum.py").read_text()
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "pend_far.py").write_text(pend)
+    home = tmp_path / "home"
+    (home / "models").mkdir(parents=True)
+    (home / "models" / "pend_near.py").write_text(pend)
+    (home / "pend_link.py").symlink_to(elsewhere / "pend_far.py")
+    far = write(home, BASE.replace('file = "pendulum"', 'file = "../elsewhere/pend_far.py"'))
+    with pytest.raises(StudyError, match=r"\[model\] file: \.\./elsewhere/pend_far\.py lies "
+                                         r"outside the study's folder .*--trust-model"):
+        load_study(far)
+    link = write(home, BASE.replace('file = "pendulum"', 'file = "pend_link.py"'), "l.toml")
+    with pytest.raises(StudyError, match=r"outside the study's folder .*through a link"):
+        load_study(link)
+    assert main(["theory", str(far)]) == 2
+    assert "--trust-model" in capsys.readouterr().err
+    assert load_study(far, trust_model=True).model.name == "pendulum"
+    assert main(["theory", str(far), "--trust-model"]) == 0
+    near = write(home, BASE.replace('file = "pendulum"', 'file = "models/pend_near.py"'),
+                 "n.toml")  # fmt: skip
+    assert load_study(near).model.name == "pendulum"
+
+
 SEARCH = """
 [model]
 file = "pendulum"

@@ -122,7 +122,7 @@ def _cmd_theory(args) -> int:
     from .spec import load_study
     from .theory import for_study
 
-    study = load_study(args.study)
+    study = load_study(args.study, trust_model=args.trust_model)
     print(study.describe())
     ds = for_study(study)
     base = study.setup()
@@ -161,7 +161,7 @@ def _cmd_run(args) -> int:
     from .run import run_study
     from .spec import load_study
 
-    study = load_study(args.study, members=args.members)
+    study = load_study(args.study, members=args.members, trust_model=args.trust_model)
     out = run_study(study, args.output, force=args.force, workers=args.workers,
                     scheduler=args.scheduler, progress=not args.quiet,
                     threads=args.threads)  # fmt: skip
@@ -258,6 +258,8 @@ def main(argv: list[str] | None = None) -> int:
     thy = sub.add_parser("theory", help="the theorems' predictions for a study, without "
                          "running the ensembles")  # fmt: skip
     thy.add_argument("study", help="study file (TOML)")
+    thy.add_argument("--trust-model", action="store_true",
+                     help="run a model file the study names outside its own folder")
     thy.set_defaults(func=_cmd_theory)
 
     run = sub.add_parser("run", help="run a study: ensembles over its grid, dataset and "
@@ -265,6 +267,8 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("study", help="study file (TOML)")
     run.add_argument("-o", "--output", help="NetCDF output (default: the study's [output])")
     run.add_argument("--members", type=int, help="override [ensemble] members")
+    run.add_argument("--trust-model", action="store_true",
+                     help="run a model file the study names outside its own folder")
     run.add_argument("--force", action="store_true",
                      help="replace an existing output (the grid points this run already "
                      "finished are kept; another study's parts are discarded)")

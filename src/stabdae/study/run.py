@@ -163,7 +163,8 @@ def _is_stabdae_dataset(path: Path) -> bool:
 
 def run_study(study, output=None, *, force: bool = False, members: int | None = None,
               workers: int | None = None, scheduler: str | None = None, progress: bool = True,
-              threads: int | None = None, log=print) -> Path:  # fmt: skip
+              threads: int | None = None, log=print,
+              trust_model: bool = False) -> Path:  # fmt: skip
     """Run every grid point of ``study`` (a :class:`Study` or a path) and write the dataset.
 
     Returns the output path.  Raises ``FileExistsError`` when the output exists and
@@ -177,7 +178,7 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     folder without a run's manifest is refused, ``force`` or not.
     """
     if not isinstance(study, Study):
-        study = load_study(study, members=members)
+        study = load_study(study, members=members, trust_model=trust_model)
     out = output_path(study, output)
     if out.exists() and not force:
         raise FileExistsError(f"{out} exists; pass --force to overwrite it")
@@ -401,7 +402,8 @@ def _run_dask(study, todo, manifest, workers, scheduler, bar):
 
 
 def _remote_point(path, members, values):
-    study = load_study(path, members=members)
+    # the process that runs the study has loaded and accepted its model already
+    study = load_study(path, members=members, trust_model=True)
     return run_point(study, values, threads=1)
 
 

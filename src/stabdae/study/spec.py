@@ -167,8 +167,12 @@ def _make_scheme(scheme: dict) -> Scheme:
 
 
 # --------------------------------------------------------------------- loading
-def load_study(path, *, members: int | None = None) -> Study:
-    """Read and validate a study file (nothing is compiled)."""
+def load_study(path, *, members: int | None = None, trust_model: bool = False) -> Study:
+    """Read and validate a study file (nothing is compiled).
+
+    ``[model] file`` must be a built-in scene or a model file in the study's folder (or
+    below it, links resolved): loading a model file runs it, and a study file is data that
+    may come from anyone.  ``trust_model=True`` (``--trust-model``) lifts that."""
     path = Path(path)
     where = path.name
     if not path.is_file():
@@ -204,6 +208,16 @@ def load_study(path, *, members: int | None = None) -> Study:
     source = path.parent / mfile if mfile.endswith(".py") else mfile
     if mfile.endswith(".py") and not Path(source).is_file():
         fail("[model] file", f"no such model file: {source}")
+    if mfile.endswith(".py") and not trust_model:
+        # loading a model file runs it: a study file (data, perhaps someone else's) may
+        # name code in its own folder, or a built-in scene, and nothing else unasked
+        home = path.parent.resolve()
+        real = Path(source).resolve()
+        if not real.is_relative_to(home):
+            via = "" if Path(os.path.abspath(source)) == real else f" (through a link, to {real})"
+            fail("[model] file", f"{mfile} lies outside the study's folder {home}{via}; a "
+                 "model file is code and loading it runs it: move it beside the study, or "
+                 "pass --trust-model (load_study(..., trust_model=True)) to run it")  # fmt: skip
     try:
         model = load_model(source)
     except ModelError as exc:
