@@ -246,6 +246,14 @@ def test_output_outside_the_study_folder_is_refused_unless_replaced(tmp_path, pa
     inside = load_study(write(tmp_path / "study", BASE.replace(
         "seed = 1", 'seed = 1\n[output]\npath = "out/x.nc"'), "inside.toml"))  # fmt: skip
     assert output_path(inside) == tmp_path / "study" / "out" / "x.nc"
+    # a link inside the study's folder that leads out of it is not followed silently
+    (tmp_path / "away").mkdir()
+    (tmp_path / "study" / "results").symlink_to(tmp_path / "away")
+    linked = load_study(write(tmp_path / "study", BASE.replace(
+        "seed = 1", 'seed = 1\n[output]\npath = "results/x.nc"'), "linked.toml"))  # fmt: skip
+    with pytest.raises(StudyError, match=r"got 'results/x.nc', which a link leads to "
+                                         r".*away/x.nc"):  # fmt: skip
+        output_path(linked)
 
 
 def test_a_tableau_in_the_study_file(tmp_path):
@@ -347,6 +355,19 @@ def test_a_study_runs_model_code_only_from_its_own_folder(tmp_path, capsys):
     near = write(home, BASE.replace('file = "pendulum"', 'file = "models/pend_near.py"'),
                  "n.toml")  # fmt: skip
     assert load_study(near).model.name == "pendulum"
+
+
+
+def test_a_step_larger_than_save_dt_keeps_the_sample_grid(tmp_path):
+    """τ > save_dt: the note states the spacing the dataset really has (save_dt, a step
+    every few samples); a τ that is not a whole multiple of save_dt would put the samples
+    off that grid, and is refused with the nearest ones that fit."""
+    study = load_study(write(tmp_path, BASE.replace("tau = 1e-3", "tau = 0.1")))
+    assert "samples every 0.05, one in 2 on a step, the others NaN" in study.describe()
+    assert study.setup()["stride"] == 2
+    with pytest.raises(StudyError, match=r"\[run\] tau: 0.125 is larger than save_dt = 0.05 "
+                                         r"and not a whole multiple .*nearest: 0.1 or 0.15"):
+        load_study(write(tmp_path, BASE.replace("tau = 1e-3", "tau = 0.125"), "b.toml"))
 
 
 SEARCH = """

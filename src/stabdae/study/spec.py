@@ -317,8 +317,15 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
             fail("[sweep]", f"{size:.3g} grid points: at most {MAX_POINTS} (one ensemble each)")
 
     if "run.tau" not in axes and "save_dt" in run and run["tau"] > run["save_dt"] * (1 + 1e-12):
+        ratio = run["tau"] / run["save_dt"]
+        if abs(ratio - round(ratio)) > 1e-9 * ratio:  # the samples would leave save_dt's grid
+            lo, hi = math.floor(ratio) * run["save_dt"], math.ceil(ratio) * run["save_dt"]
+            fail("[run] tau", f"{run['tau']:g} is larger than save_dt = {run['save_dt']:g} "
+                 f"and not a whole multiple of it, so its steps miss the sample grid; "
+                 f"nearest: {lo:g} or {hi:g}")  # fmt: skip
         notes.append(f"note: tau = {run['tau']:g} is larger than save_dt = "
-                     f"{run['save_dt']:g}: samples between two steps are NaN")  # fmt: skip
+                     f"{run['save_dt']:g}: samples every {run['save_dt']:g}, one in "
+                     f"{round(ratio)} on a step, the others NaN")  # fmt: skip
     for key in ("a", "sigma"):  # the base point of a two-stage sweep: its first value
         if f"scheme.{key}" in axes:
             scheme.setdefault(key, float(axes[f"scheme.{key}"][0]))
@@ -341,12 +348,15 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
     refused = None
     if output is not None:  # a study file is data: it writes beneath its folder or here
         target = Path(os.path.normpath(path.parent.resolve() / output))
-        if not any(target.is_relative_to(base) and target != base
-                   for base in (path.parent.resolve(), Path.cwd().resolve())):  # fmt: skip
+        real = target.resolve()  # a link on the way leads where it leads
+        bases = (path.parent.resolve(), Path.cwd().resolve())
+        if not all(any(t.is_relative_to(base) and t != base for base in bases)
+                   for t in (target, real)):  # fmt: skip
+            via = "" if real == target else f", which a link leads to {real}"
             # refused where it would be used: an output given by the caller replaces it
             refused = (f"{where}: [output] path: must lie beneath the study's folder or the "
-                       f"current one, got {output!r} (give another place with stabdae run "
-                       f"-o)")  # fmt: skip
+                       f"current one, got {output!r}{via} (give another place with stabdae "
+                       f"run -o)")  # fmt: skip
     study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
                   ensemble=ens, axes=axes,
                   output=None if output is None
