@@ -24,6 +24,7 @@ from . import _validate as check
 from ._codes import Status
 from ._ensemble_dataset import _ensemble_dataset, _warn_stopped
 from ._model import Model
+from ._raised import first_raising_member, model_raised
 from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
 from .engine.ensemble.groups import (
@@ -38,6 +39,7 @@ from .engine.ensemble.groups import (
     outputs,
 )
 from .engine.ensemble.lanes import LANES, adaptive_block_for
+from .engine.rk.steps import integrator_for
 from .engine.sampler import CHUNK, SAMPLING_RTOL, draw_alphas, residual_rows_for, sampler_for
 from .engine.threads import default_threads, run_chunks
 
@@ -275,10 +277,14 @@ def ensemble(
                     seed, save_dt, x0, params, epsilon, divergence, block, threads, progress,
                     residual_dtype, traces, states)  # fmt: skip
     clock = time.perf_counter()
-    x0, alpha0, status, g_ref = _members(run, x0)
-    wall_sample = time.perf_counter() - clock
-    clock = time.perf_counter()
-    out = run.mode.integrate(run, x0, alpha0, status, g_ref)
+    placed = None
+    try:
+        x0, alpha0, status, g_ref = placed = _members(run, x0)
+        wall_sample = time.perf_counter() - clock
+        clock = time.perf_counter()
+        out = run.mode.integrate(run, x0, alpha0, status, g_ref)
+    except Exception as exc:  # a model function raised: say which, when and where
+        raise _raised_in(run, "ensemble", exc, None if placed is None else x0) from exc
     wall_integrate = time.perf_counter() - clock
     status = np.where(status != 0, status, out.status).astype(np.int8)
     clock = time.perf_counter()
@@ -510,6 +516,35 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
     return _RunSpec(model, law, bound, scheme, mode, p, t0, float(t_end), save_dt, block,
                     members, low, high, seed, epsilon, divergence, threads, progress, rdtype,
                     trace_row, traced, bool(states), x0 is None, R, h_pred)  # fmt: skip
+
+
+def _raised_in(run: _RunSpec, who: str, exc: BaseException, x0):
+    """The error for an exception out of the kernels: with fixed steps, the first member
+    whose trajectory raises alone (the reference trajectory where the members were not
+    placed yet: ``x0`` None), replayed to the step, and the model function that raises
+    there."""
+    if isinstance(exc, MemoryError) or type(exc).__module__.split(".")[0] == "stabdae":
+        return exc  # the library's own error, already clear
+    where = None
+    if not run.adaptive:
+        g = run.mode.grid
+        kernel = integrator_for(run.model, run.bound)
+        sweeps, tol = check.projection(None, who)
+
+        def one(x_start, t_start, steps, every, ox, og, oe):
+            return kernel(x_start, t_start, g.tau, steps, every, run.p, run.bound.matrix,
+                          run.bound.scalars, run.scheme.A, run.scheme.b, run.scheme.c, sweeps,
+                          tol, ox, og, oe)  # fmt: skip
+
+        if x0 is None:  # raised while placing the members: the reference trajectory
+            starts, label = run.model.reference_state(run.p)[None, :], "the reference trajectory"
+        else:
+            starts, label = x0, "member {}"
+        where = first_raising_member(one, starts, run.t0, g.tau, int(g.nsteps),
+                                     run.model.n_residual)  # fmt: skip
+        if where is not None:
+            where = (*where[:2], label.format(where[2]))
+    return model_raised(who, run.model, run.p, exc, where)
 
 
 def default_divergence(epsilon, high, R, steps) -> float:

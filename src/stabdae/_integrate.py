@@ -12,6 +12,7 @@ from . import _validate as check
 from . import theory
 from ._codes import Status
 from ._model import Model
+from ._raised import model_raised, replay_fixed
 from ._schema import trajectory_dataset
 from .engine.rk.steps import integrator_for, multipliers_for
 
@@ -115,10 +116,16 @@ def integrate(
     out_x = np.full((nsave, 2 * model.n), np.nan)
     out_g = np.full((nsave, model.n_residual), np.nan)
     out_e = np.full(nsave, np.nan)
-    status, done = kernel(
-        x0, t0, tau, nsteps, save_every, p, bound.matrix, bound.scalars,
-        scheme.A, scheme.b, scheme.c, sweeps, tol, out_x, out_g, out_e,
-    )  # fmt: skip
+
+    def run(x_start, t_start, steps, every, ox, og, oe):
+        return kernel(x_start, t_start, tau, steps, every, p, bound.matrix, bound.scalars,
+                      scheme.A, scheme.b, scheme.c, sweeps, tol, ox, og, oe)  # fmt: skip
+
+    try:
+        status, done = run(x0, t0, nsteps, save_every, out_x, out_g, out_e)
+    except Exception as exc:  # a model function raised: say which, when and where
+        where = replay_fixed(run, x0, t0, tau, nsteps, save_every, out_x, model.n_residual)
+        raise model_raised(who, model, p, exc, where) from exc
     status = Status(status)
     if status == Status.OK:  # a trajectory that ran to the end, but far off its manifold
         norms = np.abs(out_g).max(axis=1)

@@ -301,3 +301,38 @@ def test_a_missing_f_t_is_named():
                                                    "Omega": 3.0},
                       reference_state=mod.reference_state, forces=mod.forces, f=mod.f,
                       f_q=mod.f_q, f_accel=mod.f_accel)  # fmt: skip
+
+
+@njit
+def _forces_raising_after(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = 9.81
+    if t > p[0]:
+        raise ValueError("boom")
+
+
+def test_a_raising_model_function_is_named_with_its_time_and_state():
+    """numba hands an exception out of compiled code with its message alone: integrate and
+    ensemble replay to the step that raised and name the function, the time and the state
+    (checked against the trajectory stored up to there), or say the raise came from a
+    stage of that step when no function raises at the state itself."""
+    model = unit_pendulum("raising", forces=_forces_raising_after,
+                          params={"t_raise": 0.2475})  # fmt: skip
+    law = stabdae.baumgarte(10.0)
+    ref = stabdae.integrate(model, None, law, "midpoint", 0.01, 0.25, save_dt=0.01)
+    q = np.array2string(ref.x.values[-1, :2], precision=6)
+    with pytest.raises(stabdae.ModelError) as info:
+        stabdae.integrate(model, None, law, "midpoint", 0.01, 1.0)
+    assert str(info.value) == (f"integrate: raising's forces(t, q, v, p, out) raised "
+                               f"ValueError: boom at t = 0.25, q = {q}, v = "
+                               f"{np.array2string(ref.x.values[-1, 2:], precision=6)}")
+    with pytest.raises(stabdae.ModelError, match=r"ensemble: raising's forces\(t, q, v, p, "
+                                                 r"out\) raised ValueError: boom at t = 0.25, "
+                                                 r".* \(the reference trajectory\)"):
+        stabdae.ensemble(model, law, "midpoint", 0.01, 1.0, members=4)
+    # the midpoint stage at t + τ/2 = 0.255 raises, the state at t = 0.25 does not
+    with pytest.raises(stabdae.ModelError, match=r"integrate: a function of model 'raising' "
+                                                 r"raised ValueError: boom during the step "
+                                                 r"from t = 0.25, q = .* at one of its "
+                                                 r"stages"):
+        stabdae.integrate(model, None, law, "midpoint", 0.01, 1.0, params={"t_raise": 0.2525})
