@@ -387,3 +387,16 @@ def test_load_model_sees_an_edited_file_and_an_edited_helper(model_folder, monke
     assert again is not edited
     forces = again.functions["forces"]
     assert forces.py_func.__globals__["consts_mod"].SCALE == 2.0
+
+
+def test_bounds_checked_kernels_are_keyed_apart(monkeypatch):
+    """NUMBA_BOUNDSCHECK=1 asks for kernels that check every index: a kernel compiled
+    without the checks must not come back from the cache."""
+    import numba
+
+    from stabdae.engine.cache import fingerprint
+
+    monkeypatch.setattr(numba.config, "BOUNDSCHECK", 0)
+    plain = fingerprint("pendulum", 2, 1, 0)
+    monkeypatch.setattr(numba.config, "BOUNDSCHECK", 1)
+    assert fingerprint("pendulum", 2, 1, 0) != plain

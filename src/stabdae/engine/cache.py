@@ -245,6 +245,9 @@ def fingerprint(*parts) -> str | None:
     if _has_unknown(parts):
         return None
     h = hashlib.sha256(library_fingerprint().encode())
+    # NUMBA_BOUNDSCHECK=1 compiles checked kernels: an unchecked one from the cache would
+    # defeat the run that asked for the checks (read here: it may be set at run time)
+    h.update(f"boundscheck {bool(numba.config.BOUNDSCHECK)}".encode())
     for part in parts:
         h.update(b"\x00" + repr(part).encode())
     return h.hexdigest()
