@@ -22,7 +22,10 @@ from __future__ import annotations
 
 import hashlib
 import math
+import traceback
+import warnings
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 from numba.core.dispatcher import Dispatcher
@@ -722,15 +725,36 @@ def _call_compiled(fn: Dispatcher, *args):
     """``fn(*args)``; an entry of numba's on-disk cache that refers to a module this
     process cannot import (the file was loaded under another name when it was cached) is
     passed over: the function compiles instead, and is not cached in this process."""
+    from numba.core.caching import NullCache
+
     try:
         return fn(*args)
     except ModuleNotFoundError:
-        from numba.core.caching import NullCache
-
         if isinstance(getattr(fn, "_cache", None), NullCache):
             raise
         fn._cache = NullCache()
         return fn(*args)
+    except Exception as exc:
+        # a damaged entry of numba's on-disk cache (a truncated or overwritten file): the
+        # model is not at fault; clear the entry and compile
+        cache = getattr(fn, "_cache", None)
+        if cache is None or isinstance(cache, NullCache) or not _raised_in_numba_cache(exc):
+            raise
+        where = getattr(cache, "cache_path", "numba's cache folder")
+        cache.flush()
+        warnings.warn(
+            f"numba's on-disk cache entry of {getattr(fn, '__name__', fn)} in {where} was "
+            f"damaged ({type(exc).__name__}: {exc}); it was cleared and the function "
+            "compiled again",
+            RuntimeWarning, stacklevel=3,
+        )  # fmt: skip
+        return fn(*args)
+
+
+def _raised_in_numba_cache(exc: BaseException) -> bool:
+    """Was ``exc`` raised while numba loaded an entry of its on-disk cache?"""
+    frames = traceback.extract_tb(exc.__traceback__)
+    return any(Path(f.filename).name == "caching.py" and "numba" in f.filename for f in frames)
 
 
 def _probe_boundscheck(where, fn, args, shape, governs) -> np.ndarray:

@@ -400,3 +400,30 @@ def test_bounds_checked_kernels_are_keyed_apart(monkeypatch):
     plain = fingerprint("pendulum", 2, 1, 0)
     monkeypatch.setattr(numba.config, "BOUNDSCHECK", 1)
     assert fingerprint("pendulum", 2, 1, 0) != plain
+
+
+def test_a_damaged_numba_cache_entry_is_cleared_with_a_warning_that_names_it(tmp_path):
+    """A model file's @njit(cache=True) functions with their numba cache entries
+    overwritten: the model loads, each damaged entry is named in one warning (not blamed
+    on the model), and the next process finds a sound cache again."""
+    model_file = tmp_path / "pendulum_damaged.py"
+    model_file.write_text((scene_dir() / "pendulum.py").read_text())
+    load = "import stabdae, sys; print(stabdae.load_model(sys.argv[1]).n)"
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+
+    def run():
+        out = subprocess.run([sys.executable, "-W", "always", "-c", load, str(model_file)],
+                             env=env, capture_output=True, text=True, timeout=300)  # fmt: skip
+        assert out.returncode == 0, out.stderr[-3000:]
+        assert out.stdout.strip() == "2"
+        return out.stderr
+
+    run()
+    entries = sorted((tmp_path / "__pycache__").glob("pendulum_damaged.*.nbc"))
+    assert len(entries) >= 4
+    for entry in entries:
+        entry.write_bytes(b"not a pickle")
+    said = run()
+    assert "numba's on-disk cache entry of forces in" in said and "was damaged" in said
+    assert "Model" not in said
+    assert "damaged" not in run()
