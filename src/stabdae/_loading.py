@@ -12,8 +12,8 @@ from pathlib import Path
 
 from ._model import Model, ModelError
 
-__all__ = ["load_model", "local_imports", "model_file", "module_name", "scene_names",
-           "scene_dir"]
+__all__ = ["file_sha256", "load_model", "local_imports", "model_file", "module_name",
+           "scene_names", "scene_dir"]
 
 
 def scene_dir() -> Path:
@@ -176,7 +176,7 @@ def _sources(module) -> tuple:
         file = _origin(getattr(mod, "__file__", None))
         if file is None or not file.is_file():
             continue
-        out.append((mod.__name__, str(file), _sha256(file)))
+        out.append((mod.__name__, str(file), file_sha256(file)))
         for value in list(vars(mod).values()):
             dep = value if isinstance(value, types.ModuleType) else \
                 sys.modules.get(getattr(getattr(value, "py_func", value), "__module__", None)
@@ -200,12 +200,17 @@ def _user_module(module) -> bool:
 def _sources_changed(stamp) -> bool:
     for _, file, digest in stamp:
         try:
-            if _sha256(Path(file)) != digest:
+            if file_sha256(Path(file)) != digest:
                 return True
         except OSError:
             return True
     return False
 
 
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+def file_sha256(path) -> str:
+    """SHA-256 of a file's bytes, read in blocks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()

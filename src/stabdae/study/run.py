@@ -28,7 +28,7 @@ import xarray as xr
 from .._boundary import boundary
 from .._ensemble import ensemble
 from .._integrate import IntegrationWarning
-from .._loading import local_imports
+from .._loading import file_sha256, local_imports
 from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
 from ..engine.cache import function_fingerprint, library_fingerprint
@@ -259,19 +259,11 @@ class _Manifest:
         """Write grid point ``index``'s part and record its checksum."""
         path = self.parts / f"point-{index}.nc"
         write_netcdf(_keyed(ds, index, self.fingerprint), path)
-        self.digests[path.name] = _sha256(path)
+        self.digests[path.name] = file_sha256(path)
         self.save()
 
     def matches(self, path: Path) -> bool:
-        return self.digests.get(path.name) == _sha256(path)
-
-
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+        return self.digests.get(path.name) == file_sha256(path)
 
 
 def _clear(parts: Path) -> None:
