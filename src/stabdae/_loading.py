@@ -131,8 +131,8 @@ def load_model(source, attribute: str = "model") -> Model:
     module = sys.modules.get(name)
     stamp = getattr(module, "__stabdae_sources__", None)
     if module is not None and stamp is not None and _sources_changed(stamp):
-        # edited since it was loaded (a notebook): load it, and the helper modules it
-        # reads that were edited or import one that was, afresh
+        # edited, or a helper it reads edited, since it was loaded (a notebook): load it
+        # and every helper module it reads afresh
         for dep in stamp:
             if dep[0] != name:
                 sys.modules.pop(dep[0], None)
