@@ -76,3 +76,10 @@ def test_mutants_name_tests_that_exist():
             if name:
                 assert re.search(rf"def {re.escape(name.split('[')[0])}\b",
                                  (ROOT / path).read_text()), (m.name, node)  # fmt: skip
+
+
+def test_mutants_change_code_that_exists():
+    """Each mutant's snippet occurs exactly once in its file: a snippet the code no longer
+    has would leave that place unchecked without a word."""
+    for m in MUTANTS:
+        assert (ROOT / m.file).read_text().count(m.old) == 1, (m.name, m.file, m.old)
