@@ -487,16 +487,8 @@ def spectral_radius_of(R):
         return abs(R[0, 0])
     if n == 2:
         return _radius2(R[0, 0], R[0, 1], R[1, 0], R[1, 1])
-    for i in range(n):
-        for q in range(n):
-            if not math.isfinite(R[i, q]):
-                return math.nan
-    # complex input: numba's real eigvals refuses complex eigenvalues
-    lam = np.linalg.eigvals(R.astype(np.complex128))
-    moduli = np.empty(n)
-    for i in range(n):
-        moduli[i] = abs(lam[i])
-    return _cluster_radius(moduli, n)
+    moduli = _moduli(R)
+    return math.nan if moduli.size == 0 else _cluster_radius(moduli, n)
 
 
 @njit(cache=True)
@@ -508,15 +500,24 @@ def grouped_radius_of(R, ref):
         return _radius2_grouped(R[0, 0], R[0, 1], R[1, 0], R[1, 1], ref)
     if n == 1:
         return abs(R[0, 0])
+    moduli = _moduli(R)
+    return math.nan if moduli.size == 0 else _grouped(moduli, n, ref)
+
+
+@njit(cache=True)
+def _moduli(R):
+    """The moduli of ``R``'s eigenvalues; empty where ``R`` has a non-finite entry."""
+    n = R.shape[0]
     for i in range(n):
         for q in range(n):
             if not math.isfinite(R[i, q]):
-                return math.nan
+                return np.empty(0)
+    # complex input: numba's real eigvals refuses complex eigenvalues
     lam = np.linalg.eigvals(R.astype(np.complex128))
     moduli = np.empty(n)
     for i in range(n):
         moduli[i] = abs(lam[i])
-    return _grouped(moduli, n, ref)
+    return moduli
 
 
 @njit(cache=True)

@@ -22,6 +22,16 @@ from ..rk.control import _DIVERGED, _f_eval, _first_step, _next_step, _settle
 
 # ------------------------------------------------------------------- samples
 @njit(cache=True)
+def _max_norm(g, ng):
+    """``‖g‖∞`` of a sample, ``inf`` where it is not finite (so that it fails every test
+    against the divergence threshold)."""
+    r = 0.0
+    for l in range(ng):
+        r = max(r, abs(g[l]))
+    return r if math.isfinite(r) else math.inf
+
+
+@njit(cache=True)
 def _hermite(x0, f0, x1, f1, h, theta, out):
     """The cubic Hermite interpolant at ``t0 + θ h`` of an accepted step from ``x0`` (with
     ``ẋ = f0``) to ``x1`` (``f1``), in ``out``.
@@ -226,11 +236,7 @@ def _build_adaptive_block(K, spec: Spec):
                             ts = save_times[jj[lane]]
                             _hermite(x_o, k_o, x_h, k1_h, hh, (ts - t_old) / hh, xs_h)
                             residual(ts, xs_h, p, ws_h, g_h)
-                            r = 0.0
-                            for l in range(ng):
-                                r = max(r, abs(g_h[l]))
-                            if not math.isfinite(r):
-                                r = math.inf
+                            r = _max_norm(g_h, ng)
                             jj[lane] += 1
                             if trace_row[i] >= 0:
                                 norms[trace_row[i], jj[lane]] = r
@@ -242,11 +248,7 @@ def _build_adaptive_block(K, spec: Spec):
                             for l in range(N2):
                                 x_h[l] = X[l, lane]
                             residual(t, x_h, p, ws_h, g_h)
-                            r = 0.0
-                            for l in range(ng):
-                                r = max(r, abs(g_h[l]))
-                            if not math.isfinite(r):
-                                r = math.inf
+                            r = _max_norm(g_h, ng)
                             if trace_row[i] >= 0:
                                 norms[trace_row[i], jj[lane]] = r
                             if not (r <= divergence):
