@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from hypothesis import settings
 
 import stabdae
 from stabdae._schema import udunits_ok
@@ -19,6 +20,12 @@ from stabdae.engine.jit import JIT
 #: tests that look at compiled code (signatures, LLVM IR, NRT allocations): skipped when
 #: the suite runs as Python with NUMBA_DISABLE_JIT=1
 compiled_only = pytest.mark.skipif(not JIT, reason="inspects compiled code; JIT disabled")
+
+#: property tests: a fixed number of examples, drawn the same way on every run (a
+#: failure reproduces; the suite's time is bounded), no example database written
+settings.register_profile("stabdae", max_examples=150, deadline=None, derandomize=True,
+                          database=None, print_blob=True)  # fmt: skip
+settings.load_profile("stabdae")
 
 ROOT = Path(__file__).resolve().parents[1]
 KERNELS = ROOT / "kernels"

@@ -13,6 +13,7 @@ import pytest
 from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "tests" / "mutation"))
+from generate import GROUPS, generate  # noqa: E402
 from mutants import MUTANTS  # noqa: E402
 from run import outcome_of  # noqa: E402
 
@@ -83,3 +84,21 @@ def test_mutants_change_code_that_exists():
     has would leave that place unchecked without a word."""
     for m in MUTANTS:
         assert (ROOT / m.file).read_text().count(m.old) == 1, (m.name, m.file, m.old)
+
+
+def test_generated_mutants_are_reproducible_and_change_the_code():
+    """A seed gives the same sample every time, a share of every module group, each a
+    change of the code's syntax tree (never inside a string or a message) at a place its
+    file still has, and covered by test files that exist."""
+    import ast
+
+    sample = generate(7, 3)
+    assert [m.name for m in sample] == [m.name for m in generate(7, 3)]
+    assert [m.name for m in sample] != [m.name for m in generate(8, 3)]
+    assert len(sample) == 3 * len(GROUPS) and len({m.name for m in sample}) == len(sample)
+    for m in sample:
+        text = (ROOT / m.file).read_text()
+        mutated = m.apply(text)
+        assert mutated is not None, m.name
+        assert ast.dump(ast.parse(mutated)) != ast.dump(ast.parse(text)), m.name
+        assert all((ROOT / t).is_file() for t in m.tests), m.name

@@ -16,6 +16,20 @@ class Mutant:
     new: str
     tests: tuple  # the node ids (or whole test files) that cover the place
     what: str
+    line: int = 0  # generated mutants: ``old`` starts at this line (1-based) and column
+    col: int = 0
+
+    def apply(self, text: str) -> str | None:
+        """The file's text with this change, or None where ``old`` is not where it should
+        be (more than once in the file, for a hand-written mutant)."""
+        if not self.line:
+            return text.replace(self.old, self.new) if text.count(self.old) == 1 else None
+        lines = text.split("\n")
+        src = lines[self.line - 1] if self.line <= len(lines) else ""
+        if src[self.col:self.col + len(self.old)] != self.old:
+            return None
+        lines[self.line - 1] = src[:self.col] + self.new + src[self.col + len(self.old):]
+        return "\n".join(lines)
 
 
 E = "src/stabdae/engine/"
@@ -616,4 +630,31 @@ MUTANTS = [
            ('tests/drivers/test_adaptive_ensemble.py::test_adaptive_prediction_wakes_no_lapack_solve',
             'tests/drivers/test_adaptive_ensemble.py::test_expm_by_products_is_scipys_to_roundoff'),
            "the prediction's propagator e^{Ãh} is e^{Ãh/2} for a scaled matrix"),
+    # ---- a reviewer's changes that passed the suite (each now caught by a test that says
+    #      what it checks)
+    Mutant("growth-middle-dropped",
+           E + "decay/fit.py",
+           "    return (w4 > GROWTH * w2) & (w4 >= w3) & (w3 >= w2)",
+           "    return (w4 > GROWTH * w2) & (w4 >= w2)",
+           ('tests/drivers/test_verdict_reference.py::test_growth_predicate_truth_table',),
+           "the growth predicate drops its monotone middle condition"),
+    Mutant("roundoff-time-term-dropped",
+           S + "_measures.py",
+           "            terms = terms + np.abs(Gt[i] - G[i, -1]) / h",
+           "            terms = terms",
+           ('tests/drivers/test_verdict_reference.py::test_roundoff_level_of_a_moving_constraint_in_closed_form',),
+           "the roundoff level drops the ∂g/∂t · t term"),
+    Mutant("boundary-ignores-q",
+           S + "_boundary.py",
+           "                             int(ds.members_unstable), q)",
+           "                             int(ds.members_unstable), 0.0)",
+           ('tests/theory/test_boundary.py::test_boundary_allows_the_unstable_fraction_q[0.25]',),
+           "the boundary search ignores the allowed unstable fraction q"),
+    Mutant("run-key-without-ensemble",
+           S + "study/run.py",
+           "    h.update(json.dumps(study.ensemble, sort_keys=True).encode())",
+           "    h.update(b'')",
+           ('tests/study/test_run.py::test_resume_with_another_member_count_starts_over_and_equals_a_clean_run',
+            'tests/study/test_run.py::test_every_setting_that_decides_the_numbers_is_in_the_run_key'),
+           "the study's resume key leaves out the ensemble settings (--members)"),
 ]

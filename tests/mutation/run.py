@@ -24,6 +24,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from generate import generate  # noqa: E402
 from mutants import MUTANTS  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -68,11 +69,12 @@ def run_mutant(m, timeout: float) -> dict:
         _copy_tree(tmp)
         path = tmp / m.file
         text = path.read_text()
-        count = text.count(m.old)
-        if count != 1:
-            return {"name": m.name, "outcome": f"NOT APPLIED ({count} matches)", "test": "",
+        mutated = m.apply(text)
+        if mutated is None:
+            where = f"line {m.line}" if m.line else f"{text.count(m.old)} matches"
+            return {"name": m.name, "outcome": f"NOT APPLIED ({where})", "test": "",
                     "seconds": 0.0}  # fmt: skip
-        path.write_text(text.replace(m.old, m.new))
+        path.write_text(mutated)
         env = dict(os.environ, PYTHONPATH=str(tmp / "src"),
                    STABDAE_CACHE_DIR=str(tmp / ".cache"), PYTHONDONTWRITEBYTECODE="1")
         cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
@@ -95,9 +97,14 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2, help="mutants run at once (default 2)")
     ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per mutant")
     ap.add_argument("--list", action="store_true", help="list the mutants and exit")
+    ap.add_argument("--generate", type=int, metavar="SEED",
+                    help="run a generated sample (generate.py) instead of the hand list")
+    ap.add_argument("--per-module", type=int, default=8,
+                    help="with --generate: mutants per module group (default 8)")
     args = ap.parse_args(argv)
-    chosen = [m for m in MUTANTS if not args.names or m.name in args.names]
-    unknown = set(args.names) - {m.name for m in MUTANTS}
+    pool = MUTANTS if args.generate is None else generate(args.generate, args.per_module)
+    chosen = [m for m in pool if not args.names or m.name in args.names]
+    unknown = set(args.names) - {m.name for m in pool}
     if unknown:
         ap.error(f"unknown mutants: {', '.join(sorted(unknown))}")
     if args.list:
@@ -120,7 +127,8 @@ def main(argv=None) -> int:
     print(f"\n| {'mutant':{width}s} | place | change | outcome | caught by | s |")
     print(f"|{'-' * (width + 2)}|---|---|---|---|---|")
     for m, r in zip(chosen, results):
-        print(f"| {m.name:{width}s} | `{m.file.removeprefix('src/')}` | {m.what} | "
+        place = m.file.removeprefix("src/") + (f":{m.line}" if m.line else "")
+        print(f"| {m.name:{width}s} | `{place}` | {m.what} | "
               f"{r['outcome']} | {r['test']} | {r['seconds']:.0f} |")  # fmt: skip
     survived = [r["name"] for r in results if not r["outcome"].startswith("caught")]
     print(f"\n{len(results) - len(survived)} of {len(results)} caught in "

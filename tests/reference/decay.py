@@ -97,8 +97,9 @@ def fit_polynomial(t, y, dt: float) -> tuple[float, float]:
 
 
 def estimate(t: np.ndarray, v: np.ndarray) -> dict:
-    """β, γ, the window's first and last time and its number of points, and the kind of
-    fit ("exponential", "polynomial", "oscillating"; None: no window) of one trace."""
+    """β, γ, the window's first and last time and its number of points, the kind of fit
+    ("exponential", "polynomial", "oscillating"; None: no window) of one trace, and what
+    chose the kind: the two fits' sums of squares and the kept one's RMS."""
     rt, ry = envelope(t, v)
     w = fifths(t, v)
     still = w[2] >= STILL_DECAYING * w[3] and w[3] >= STILL_DECAYING * w[4]
@@ -108,14 +109,17 @@ def estimate(t: np.ndarray, v: np.ndarray) -> dict:
     tt, yy = rt[start:end], ry[start:end]
     slope, intercept = np.polyfit(tt, yy, 1)
     beta, kind = -slope, "exponential"
-    sse = float(np.sum((yy - (intercept + slope * tt)) ** 2))
+    sse = sse_exp = float(np.sum((yy - (intercept + slope * tt)) ** 2))
+    sse_poly = math.nan
     if end - start >= 6:
-        bp, sp = fit_polynomial(tt, yy, t[1] - t[0])
-        if sp < sse:
-            beta, sse, kind = bp, sp, "polynomial"
-    if math.sqrt(sse / (end - start)) > SMOOTH_RMS:
+        bp, sse_poly = fit_polynomial(tt, yy, t[1] - t[0])
+        if sse_poly < sse:
+            beta, sse, kind = bp, sse_poly, "polynomial"
+    rms = math.sqrt(sse / (end - start))
+    if rms > SMOOTH_RMS:
         b = np.polyfit(yy, tt, 1)[0]
         beta, kind = -1.0 / b, "oscillating"
     gamma = math.exp(np.max(ry[:end] + beta * rt[:end]))
     return {"beta": beta, "gamma": gamma, "fit_start": rt[start], "fit_end": rt[end - 1],
-            "fit_points": end - start, "kind": kind}
+            "fit_points": end - start, "kind": kind, "sse_exponential": sse_exp,
+            "sse_polynomial": sse_poly, "rms": rms}

@@ -366,3 +366,80 @@ def test_a_second_run_on_the_same_output_is_refused_while_the_first_lives(tmp_pa
         sleeper.wait()
     out = run_study(study, progress=False, log=lambda *a: None)  # the holder is gone
     assert out.is_file() and not parts.exists()
+
+
+def test_resume_with_another_member_count_starts_over_and_equals_a_clean_run(tmp_path,
+                                                                           monkeypatch):
+    """``--members`` changes the numbers without changing the study file: parts of 16
+    members are not mixed into a run of 24 (the run key covers the ensemble settings as
+    run); the resumed run starts over and equals a clean run of 24 members."""
+    study = study_file(tmp_path, members=16, t_end=0.2, omegas="5.0")
+    _interrupted(study, 2, monkeypatch)
+    said = []
+    out = run_study(study, members=24, progress=False, log=said.append)
+    assert any("starting over" in line for line in said), said
+    clean = tmp_path / "clean"
+    clean.mkdir()
+    (clean / "study.toml").write_text(study.read_text())
+    ref = run_study(clean / "study.toml", members=24, progress=False, log=lambda *a: None)
+    got = xr.open_dataset(out).load()
+    assert got.sizes["member"] == 24
+    same_data(got, xr.open_dataset(ref).load())
+
+
+#: one change to each section of the study file that decides the numbers
+_STUDY_EDITS = {
+    "model parameter": ('file = "models/pend.py"',
+                        'file = "models/pend.py"\nparams = {g = 1.62}'),
+    "law": ("omega = 10.0", "omega = 11.0"),
+    "scheme": ('name = "rk2"', 'name = "euler"'),
+    "run": ("save_dt = 0.05", "save_dt = 0.1"),
+    "ensemble": ("seed = 3", "seed = 4"),
+    "grid": ("tau = [5e-4, 1e-3", "tau = [6e-4, 1e-3"),
+}
+
+
+def test_every_setting_that_decides_the_numbers_is_in_the_run_key(tmp_path, monkeypatch):
+    """The run key changes with each thing that decides a grid point's numbers, one at a
+    time: each section of the study file, the member count given on the command line, a
+    module the model imports from its folder, the library's source and its version; and
+    it does not change when nothing does (the same study loaded again)."""
+    import stabdae.study.run as runner
+    from stabdae.study.spec import load_study
+
+    models = tmp_path / "models"
+    models.mkdir()
+    (models / "pend_local.py").write_text("G_SCALE = 1.0\n")
+    source = (ROOT / "kernels" / "pendulum.py").read_text()
+    (models / "pend.py").write_text("import pend_local  # noqa: F401\n" + source)
+    text = STUDY.format(members=16, t_end=0.2, omegas="5.0").replace(
+        'file = "pendulum"', 'file = "models/pend.py"')
+    study = tmp_path / "study.toml"
+    study.write_text(text)
+    monkeypatch.syspath_prepend(str(models))
+
+    def key(**kw):
+        return runner._fingerprint(load_study(study, **kw))
+
+    base = key()
+    assert key() == base
+    changed = {}
+    for what, (old, new) in _STUDY_EDITS.items():
+        assert old in text, what
+        study.write_text(text.replace(old, new, 1))
+        changed[what] = key()
+    study.write_text(text)
+    changed["--members"] = key(members=32)
+    (models / "pend_local.py").write_text("G_SCALE = 2.0\n")
+    changed["local module"] = key()
+    (models / "pend_local.py").write_text("G_SCALE = 1.0\n")
+    assert key() == base
+    with monkeypatch.context() as m:
+        m.setattr(runner, "library_fingerprint", lambda: "another library")
+        changed["library source"] = key()
+    with monkeypatch.context() as m:
+        m.setattr(runner, "__version__", "0.0.0+other")
+        changed["library version"] = key()
+    same = [what for what, k in changed.items() if k == base]
+    assert not same, f"the run key ignores: {same}"
+    assert len(set(changed.values())) == len(changed)

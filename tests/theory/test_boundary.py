@@ -15,6 +15,7 @@ from conftest import assert_schema, load_scene
 from models.affine import model as affine
 from stabdae import theory
 from stabdae._measures import BRACKETED, CLASSES, HIGH_END_STABLE, LOW_END_FAILS
+from stabdae._schemes import as_scheme
 
 #: f̈ = −100 f − 20 ḟ (ω = 10, ξ = 1: a Jordan block) and ḣ = −10 h
 AFFINE_LAW = stabdae.matrix([[-100.0, -20.0, 0.0], [0.0, 0.0, -10.0]])
@@ -77,6 +78,44 @@ def test_boundary_says_when_the_bracket_does_not_hold_it():
     assert float(low.tau_star_low) == 2e-3 and low.sizes["probe"] == 2
 
 
+def _fraction_law(tau0, tau1):
+    """A stand-in for the ensemble a probe runs: of ``n`` members, ``⌊n x⌋`` unstable and
+    the rest stable, ``x = (τ − τ0)/(τ1 − τ0)`` clipped to [0, 1]."""
+    import xarray as xr
+
+    def fake(model, law, scheme, tau, t_end, *, members, **kw):
+        x = min(1.0, max(0.0, (tau - tau0) / (tau1 - tau0)))
+        u = math.floor(members * x)
+        s = members - u
+        return xr.Dataset({"fraction_stable": s / members, "fraction_stable_low": 0.0,
+                           "fraction_stable_high": 1.0, "members_run": members,
+                           "members_stable": s, "members_unstable": u, "members_undecided": 0,
+                           "members_diverged": 0, "members_growing": u})  # fmt: skip
+    return fake
+
+
+@pytest.mark.parametrize("q", [0.0, 0.25])
+def test_boundary_allows_the_unstable_fraction_q(q, monkeypatch):
+    """Probes whose unstable count rises linearly with τ (``⌊n (τ − 0.1)/0.4⌋`` of ``n``):
+    each probe is stable exactly where its fraction stable is at least ``1 − q``, and the
+    boundary is where the full ensemble's unstable count first exceeds ``q n``,
+    ``τ = 0.1 + 0.4 (⌊q n⌋ + 1)/n``."""
+    from stabdae import _boundary
+
+    monkeypatch.setattr(_boundary, "ensemble", _fraction_law(0.1, 0.5))
+    n = 40
+    ds = stabdae.boundary(affine, AFFINE_LAW, "euler", tau=(0.01, 1.0), rtol=1e-4,
+                          members=n, search_members=20, q=q, steps=50)  # fmt: skip
+    frac = ds.probe_fraction_stable.values
+    assert (ds.probe_stable.values == (frac >= 1.0 - q)).all()
+    assert int(ds.tau_star_reason) == BRACKETED
+    edge = 0.1 + 0.4 * (math.floor(q * n) + 1) / n
+    assert float(ds.tau_star_low) < edge <= float(ds.tau_star_high)
+    assert float(ds.tau_star_high) <= float(ds.tau_star_low) * (1 + 1e-4)
+    if q > 0:  # a stable probe with unstable members: q decided it
+        assert ((frac < 1.0) & (ds.probe_stable.values == 1)).any()
+
+
 def test_boundary_errors():
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)
@@ -103,6 +142,36 @@ def test_condition4_and_forced_gain_against_closed_forms():
     assert theory.forced_gain(np.array([[r]])) == pytest.approx(1 / (1 - r), rel=1e-5)
     assert theory.forced_gain(np.array([[1.01]])) == math.inf
     assert theory.condition4(np.array([[1.01]]), np.array(g)[:, None])["epsilon"] == math.inf
+
+
+def test_condition4_with_a_non_symmetric_map_and_constant_forcing():
+    """``g_{k+1} = R g_k + e`` with ``R`` non-symmetric (a rotation and a shear, ρ < 1 but
+    ``‖R‖₂ > 1``) and a constant ``e``: the remainders are ``e`` itself; the weight from
+    the definition (``RᵀXR − X = −I`` solved as a Kronecker system, ``P = X^{1/2}``) gives
+    ``q = ‖P R P⁻¹‖₂ < 1`` and ``ε = ‖P⁻¹‖₂ ‖P e‖₂ / (1 − q)``; and the orbit keeps
+    the bound ``‖g_k‖∞ ≤ max(start, ε)`` (the theorems' claim)."""
+    from scipy.linalg import sqrtm
+
+    R = np.array([[0.5, 0.9, 0.0], [-0.3, 0.4, 0.2], [0.0, 0.1, -0.6]])
+    e = np.array([2e-3, -1e-3, 5e-4])
+    g = [np.array([0.3, -0.2, 0.1])]
+    for _ in range(400):
+        g.append(R @ g[-1] + e)
+    g = np.array(g)
+    out = theory.condition4(R, g)
+    n = R.shape[0]
+    X = np.linalg.solve(np.kron(R.T, R.T) - np.eye(n * n), -np.eye(n).ravel()).reshape(n, n)
+    P = np.real(sqrtm(0.5 * (X + X.T)))
+    Pinv = np.linalg.inv(P)
+    q = np.linalg.norm(P @ R @ Pinv, 2)
+    assert np.linalg.norm(R, 2) > 1.0 > q
+    assert out["q"] == pytest.approx(q, rel=1e-10)
+    assert out["remainder"] == pytest.approx(np.abs(e).max(), rel=1e-9)
+    eps = np.linalg.norm(Pinv, 2) * np.linalg.norm(P @ e) / (1.0 - q)
+    assert out["epsilon"] == pytest.approx(eps, rel=1e-8)
+    start = np.linalg.norm(Pinv, 2) * np.linalg.norm(P @ g[0])
+    assert out["start"] == pytest.approx(start, rel=1e-10)
+    assert np.abs(g).max(axis=1).max() <= max(out["start"], out["epsilon"])
 
 
 def test_roundoff_growing_with_the_state_is_not_growth():
@@ -192,3 +261,48 @@ def test_short_probes_never_pass_the_spectral_limit(steps):
             assert float(ds.tau_star_high) <= limit * 1.011
         assert not float(ds.tau_star_low) > limit
         assert not float(ds.tau_star) > limit * 1.011
+
+
+#: docs/theory.md's table: ωτ, ξ, kτ and, where not deadbeat, the first-order ρ
+_PUBLISHED_GAINS = {
+    "euler": (1.0, 1.0, 1.0, 0.0), "midpoint": (math.sqrt(2), 1 / math.sqrt(2), 1.0, 0.5),
+    "heun": (math.sqrt(2), 1 / math.sqrt(2), 1.0, 0.5), "rk3": (1.939, 0.362, 1.596, None),
+    "rk4": (1.945, 0.889, 1.596, 0.27),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("scheme", list(_PUBLISHED_GAINS))
+def test_recommended_gain_is_the_published_value_and_the_brute_force_minimum(scheme):
+    """``recommend_gain`` gives the published gains (to the table's digits), and no gain
+    of a dense grid (ωτ in (0, 4], ξ in (0, 2]; kτ in [0, 6]) has a smaller spectral
+    radius, each radius computed from the definition: ``R(τÃ) = Σ c_j (τÃ)^j`` with
+    ``Ã = [[0, 1], [−ω², −2ξω]]`` (or ``−k``) and its eigenvalues."""
+    tau = 0.1
+    rec = theory.recommend_gain(scheme, tau)
+    wt, xi, kt, rho1 = _PUBLISHED_GAINS[scheme]
+    assert rec["omega"] * tau == pytest.approx(wt, abs=6e-4)
+    assert rec["xi"] == pytest.approx(xi, abs=6e-4)
+    assert rec["k"] * tau == pytest.approx(kt, abs=6e-4)
+    if rho1 is not None:
+        assert rec["rho_first_order"] == pytest.approx(rho1, abs=6e-3)
+    tab = as_scheme(scheme)
+
+    def step(Z):
+        """One step of the tableau on y' = Z y (unit step) from every unit vector."""
+        stages = []
+        for i in range(tab.stages):
+            Y = np.eye(len(Z)) + sum(tab.A[i, j] * stages[j] for j in range(i))
+            stages.append(Z @ Y)
+        return np.eye(len(Z)) + sum(b * K for b, K in zip(tab.b, stages))
+
+    def rho_block(w, x):
+        return float(np.abs(np.linalg.eigvals(step(np.array([[0.0, 1.0],
+                                                             [-w * w, -2.0 * x * w]])))).max())
+
+    assert rho_block(rec["omega"] * tau, rec["xi"]) == pytest.approx(rec["rho_holonomic"],
+                                                                     abs=1e-6)  # fmt: skip
+    grid = min(rho_block(w, x) for w in np.linspace(0.02, 4.0, 200)
+               for x in np.linspace(0.01, 2.0, 100))  # fmt: skip
+    assert rec["rho_holonomic"] <= grid + 1e-9
+    first = min(abs(step(np.array([[-x]]))[0, 0]) for x in np.linspace(0.0, 6.0, 6001))
+    assert rec["rho_first_order"] <= first + 1e-9
