@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import importlib.util
+import os
 import re
 import sys
 from pathlib import Path
@@ -11,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from hypothesis import settings
+from hypothesis import Phase, settings
 
 import stabdae
 from stabdae._schema import udunits_ok
@@ -25,7 +26,10 @@ compiled_only = pytest.mark.skipif(not JIT, reason="inspects compiled code; JIT 
 #: failure reproduces; the suite's time is bounded), no example database written
 settings.register_profile("stabdae", max_examples=150, deadline=None, derandomize=True,
                           database=None, print_blob=True)  # fmt: skip
-settings.load_profile("stabdae")
+#: the mutation runner's: a failure is all it needs to know, not the smallest example
+settings.register_profile("mutation", parent=settings.get_profile("stabdae"),
+                          phases=[Phase.explicit, Phase.reuse, Phase.generate])  # fmt: skip
+settings.load_profile(os.environ.get("STABDAE_HYPOTHESIS_PROFILE", "stabdae"))
 
 ROOT = Path(__file__).resolve().parents[1]
 KERNELS = ROOT / "kernels"

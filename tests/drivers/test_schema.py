@@ -64,3 +64,113 @@ def test_schema_page_is_generated_from_the_schema():
         "docs/schema.md is stale: regenerate it with python -c \"from stabdae._schema import "
         "schema_markdown; open('docs/schema.md', 'w').write(schema_markdown())\""
     )
+
+
+# ---------------------------------------------------------------- dimensional analysis
+#: base dimensions of the unit symbols the scenes use
+_BASE = {"m": {"m": 1}, "s": {"s": 1}, "kg": {"kg": 1}, "rad": {"rad": 1},
+         "J": {"kg": 1, "m": 2, "s": -2}, "N": {"kg": 1, "m": 1, "s": -2}}  # fmt: skip
+
+
+def _dims(units: str) -> dict:
+    """``"J m-1 s"`` → ``{kg: 1, m: 1, s: -1}``: each factor's base dimensions to its power."""
+    import re
+
+    out: dict = {}
+    for factor in units.split():
+        if factor == "1":
+            continue
+        sym, power = re.fullmatch(r"([A-Za-z]+)(-?\d*)", factor).groups()
+        for base, k in _BASE[sym].items():
+            out[base] = out.get(base, 0) + k * int(power or 1)
+    return {b: k for b, k in out.items() if k}
+
+
+def _times(*dims, power=1):
+    out: dict = {}
+    for d in dims:
+        for b, k in d.items():
+            out[b] = out.get(b, 0) + k
+    return {b: power * k for b, k in out.items() if k}
+
+
+RATES = {"beta", "beta_predicted", "beta_median", "beta_median_low", "beta_median_high",
+         "beta_theory", "beta_theory_discrete", "beta_lyapunov", "beta_theorem5_proven",
+         "beta_theorem5_printed", "theorem5_beta_proven", "theorem5_beta_printed"}  # fmt: skip
+TIMES = {"fit_start", "fit_end", "tau_star", "tau_star_low", "tau_star_high", "probe_tau",
+         "tau_limit_spectral", "tau_limit_max_norm", "tau_limit_two_norm",
+         "tau_limit_weighted_norm", "tau_limit_floor"}  # fmt: skip
+RESIDUALS = {"residual_norm", "alpha0_norm", "gamma", "residual_floor", "max_residual",
+             "final_residual", "stability_radius", "stability_radius_low",
+             "stability_radius_high", "gamma_theorem5", "path_epsilon", "path_remainder",
+             "path_residual_norm", "path_bound_start"}  # fmt: skip
+ENERGIES = {"energy", "energy_drift"}
+PER_ENTRY = {"x": "state", "x0": "state", "x_final": "state", "residual": "component",
+             "alpha0": "component", "multiplier": "multiplier",
+             "acceleration": "acceleration"}  # fmt: skip
+
+
+def test_units_follow_from_the_models_declared_units():
+    """Dimensional analysis of every schema variable for the Chaplygin sleigh (a velocity
+    constraint in m s-1, coordinates in m and rad, energy in J) and the pendulum (a
+    position constraint in m², energy per mass in m² s-2): rates are per second, times
+    in seconds, residual norms in the unit of g's components (none where f and ḟ differ:
+    then per component), energies in the energy's, the
+    rest pure numbers; per entry, a velocity is its coordinate per second, ḟ is f per
+    second, an acceleration its coordinate per second squared, and a multiplier makes
+    ``Fᵀλ`` a generalized force: energy per unit of f, or per unit of h and second (a
+    velocity constraint's row of F is ∂h/∂v)."""
+    from stabdae._schema import SCHEMA, schema_variable
+
+    for scene in ("chaplygin_sleigh", "pendulum"):
+        model = load_scene(scene)
+        q = [_dims(u) for u in model.coordinate_units]
+        c = [_dims(u) for u in model.constraint_units]
+        energy = _dims(model.energy_units)
+        per_s = {"s": -1}
+        f, h = c[: model.m], c[model.m:]
+        want_entry = {
+            "state": q + [_times(d, per_s) for d in q],
+            "component": f + [_times(d, per_s) for d in f] + h,
+            "multiplier": [_times(energy, _times(d, power=-1)) for d in f]
+            + [_times(energy, _times(d, {"s": 1}, power=-1)) for d in h],
+            "acceleration": [_times(d, {"s": -2}) for d in q],
+        }
+        got_entry = {"state": model.state_units, "component": model.component_units,
+                     "multiplier": model.multiplier_units,
+                     "acceleration": model.acceleration_units}  # fmt: skip
+        for kind, units in got_entry.items():
+            assert [_dims(u) for u in units] == want_entry[kind], (scene, kind, units)
+        comp = want_entry["component"]  # a norm over g = (f, ḟ, h) has one unit or none
+        common = comp[0] if all(d == comp[0] for d in comp) else None
+        for name in SCHEMA:
+            attrs = schema_variable(name, 0.0, model, dims=()).attrs
+            if name in PER_ENTRY:
+                assert "units_per_component" in attrs or "units" in attrs, name
+                continue
+            units = attrs.get("units")
+            if name in RESIDUALS and common is None:
+                assert units is None, name
+                continue
+            want = (per_s if name in RATES else {"s": 1} if name in TIMES
+                    else common if name in RESIDUALS else energy if name in ENERGIES
+                    else {})  # fmt: skip
+            assert _dims(units) == want, (scene, name, units)
+    assert model.name == "pendulum" and _dims(model.multiplier_units[0]) == {"s": -2}
+
+
+def test_a_norm_over_components_of_different_units_says_so():
+    """The pendulum's residual norm runs over f (m²) and ḟ (m² s-1): no single unit, the
+    per-component coordinate named, and a comment saying which unit the norm is in, kept
+    beside a comment the variable already has; the sleigh's (one unit) has neither."""
+    from stabdae._schema import schema_variable
+
+    pend, sleigh = load_scene("pendulum"), load_scene("chaplygin_sleigh")
+    norm = schema_variable("residual_norm", 0.0, pend, dims=()).attrs
+    gamma = schema_variable("gamma", 0.0, pend, dims=()).attrs
+    assert "units" not in norm and norm["units_per_component"] == "component_units"
+    assert norm["comment"].startswith("NaN after a member stopped; max over residual "
+                                      "components of different units")  # fmt: skip
+    assert gamma["comment"].startswith("max over residual components of different units")
+    one = schema_variable("residual_norm", 0.0, sleigh, dims=()).attrs
+    assert one["units"] == "m s-1" and "different units" not in one.get("comment", "")

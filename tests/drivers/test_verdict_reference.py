@@ -62,30 +62,57 @@ def test_ensemble_verdict_truth_table():
     assert seen == {_measures.V_STABLE, _measures.V_UNSTABLE, _measures.V_UNDECIDED}
 
 
+def _near(x: float) -> list[float]:
+    """``x`` and its neighbours a rounding away: where a comparison with it flips."""
+    return [x, x * (1 + 1e-12), x * (1 - 1e-12)] if math.isfinite(x) else [x]
+
+
 @st.composite
 def members(draw):
+    """Members with random settings, their values drawn from the lattice, random floats,
+    or the rule's own thresholds for those settings and their neighbours (the noise
+    level, the allowed deviation, the law's peak, growth by exactly 1.5)."""
     n = draw(st.integers(1, 24))
-    cols = {c: np.array(draw(st.lists(value, min_size=n, max_size=n)))
-            for c in ("initial", "d2", "d3", "d4", "largest", "w2", "w3", "w4")}  # fmt: skip
-    status = np.array(draw(st.lists(st.sampled_from(STATUSES), min_size=n, max_size=n)),
-                      dtype=np.int8)  # fmt: skip
     band = draw(st.none() | st.lists(value.filter(lambda x: not math.isinf(x)),
                                      min_size=5, max_size=5))  # fmt: skip
     theory = draw(st.booleans())
     bounds = draw(st.lists(positive, min_size=5, max_size=5)) if theory else None
     rho = draw(st.sampled_from([0.5, 0.999, 1.0, 1.5]) | st.floats(0.0, 2.0)) if theory \
         else math.nan
-    divergence = draw(st.sampled_from([math.inf, 1.0, 3.0, 9.0]) | st.floats(1e-3, 1e3))
     roundoff = draw(st.sampled_from([0.0, 0.01, 0.1]) | st.floats(0.0, 1.0))
     epsilon = draw(positive)
+    b = [0.0 if band is None or math.isnan(x) else x for x in (band or [0.0] * 5)]
+    noise = [ref.FLOOR_BAND * x + ref.ROUNDOFF_MARGIN * roundoff for x in b]
+    cols = {c: np.empty(n) for c in ("initial", "d2", "d3", "d4", "largest", "w2", "w3",
+                                     "w4")}  # fmt: skip
+    peaks = []
+    for j in range(n):
+        d0 = draw(value | st.sampled_from(_near(noise[0])))
+        marks = _near(noise[0]) + _near(noise[4]) + _near(d0)
+        if theory:
+            marks += _near(ref.TRANSIENT_SLACK * bounds[4] * d0 + noise[4])
+            peaks += _near(ref.TRANSIENT_SLACK * max(bounds) * d0 + max(noise))
+        d4 = draw(value | st.sampled_from(marks))
+        d3 = draw(value | st.sampled_from(_near(d4) + _near(d4 / ref.GROWTH)))
+        d2 = draw(value | st.sampled_from(_near(d3) + _near(d4 / ref.GROWTH)))
+        w4 = draw(value | st.sampled_from(_near(epsilon)))
+        w3 = draw(value | st.sampled_from(_near(ref.STILL_DECAYING * w4)))
+        w2 = draw(value | st.sampled_from(_near(ref.STILL_DECAYING * w3)))
+        largest = draw(value | st.sampled_from(_near(epsilon)))
+        for c, x in zip(cols, (d0, d2, d3, d4, largest, w2, w3, w4)):
+            cols[c][j] = x
+    status = np.array(draw(st.lists(st.sampled_from(STATUSES), min_size=n, max_size=n)),
+                      dtype=np.int8)  # fmt: skip
+    divergence = draw(st.sampled_from([math.inf, 1.0, 3.0, 9.0] + peaks) | st.floats(1e-3, 1e3))
     return cols, status, band, bounds, rho, divergence, roundoff, epsilon
 
 
 @given(members())
 def test_verdict_and_class_are_the_references(case):
     """Every member's verdict, reason and class is the reference's, for random members
-    (lattice values with ties, the unmeasured −inf, NaN, every status), with and without
-    the theory, ρ on both sides of 1, any floor band, divergence threshold and roundoff."""
+    (lattice values with ties, the rule's thresholds and their neighbours, the unmeasured
+    −inf, NaN, every status), with and without the theory, ρ on both sides of 1, any floor
+    band, divergence threshold and roundoff."""
     cols, status, band, bounds, rho, divergence, roundoff, epsilon = case
     v, r = _measures.verdict(cols, status, band, None if bounds is None else np.array(bounds),
                              rho=rho, divergence=divergence, roundoff=roundoff)  # fmt: skip
@@ -177,3 +204,40 @@ def test_stride_is_the_references(entries):
         change = max(abs(np.log(lam.astype(complex))))
         assert abs(0.2 / change - round(0.2 / change)) < 1e-9
         assert abs(got - want) == 1
+
+
+# ------------------------------------------------------------------ summaries
+@given(st.lists(st.tuples(st.sampled_from([0, 1, 2]), st.integers(0, 7),
+                          st.sampled_from([0.5, 1.0, 2.0, math.nan]),
+                          st.sampled_from([1e-4, 1e-3, 1e-2, 1e-1])),
+                min_size=1, max_size=30))  # fmt: skip
+def test_summaries_count_what_they_name(rows):
+    """Every count and fraction of the summaries from its definition, member by member:
+    run (class not ``not run``), stable / unstable / undecided / bounded (stable with the
+    largest ≤ ε) among those that ran, diverged and growing by class, β where finite;
+    the fractions over the members that ran; the δ* reason's text is its code's."""
+    verdicts = np.array([r[0] for r in rows], dtype=np.int8)
+    cls = np.array([r[1] for r in rows], dtype=np.int8)
+    largest = np.array([r[2] for r in rows])
+    alpha = np.array([r[3] for r in rows])
+    meas = {"largest": largest, "beta": np.where(np.isnan(largest), np.nan, 1.0 / alpha)}
+    eps = 1.0
+    out, why = _measures.summaries(meas, verdicts, None, cls, alpha, eps)
+    ran = [c != _measures.NOT_RUN for c in cls]
+    n = sum(ran)
+    want = {
+        "members_run": n,
+        "members_stable": sum(r and v == 0 for r, v in zip(ran, verdicts)),
+        "members_unstable": sum(r and v == 1 for r, v in zip(ran, verdicts)),
+        "members_undecided": sum(r and v == 2 for r, v in zip(ran, verdicts)),
+        "members_bounded": sum(r and v == 0 and x <= eps
+                               for r, v, x in zip(ran, verdicts, largest)),
+        "members_diverged": sum(c == _measures.DIVERGED for c in cls),
+        "members_growing": sum(c == _measures.GROWING for c in cls),
+        "members_with_beta": sum(not math.isnan(x) for x in largest),
+    }  # fmt: skip
+    assert {k: out[k] for k in want} == want
+    for name in ("stable", "unstable", "undecided", "bounded"):
+        frac = want["members_" + name] / n if n else math.nan
+        assert out["fraction_" + name] == pytest.approx(frac, nan_ok=True)
+    assert why == _measures.RADIUS_REASONS[out["stability_radius_reason"]]

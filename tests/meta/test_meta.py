@@ -101,4 +101,4 @@ def test_generated_mutants_are_reproducible_and_change_the_code():
         mutated = m.apply(text)
         assert mutated is not None, m.name
         assert ast.dump(ast.parse(mutated)) != ast.dump(ast.parse(text)), m.name
-        assert all((ROOT / t).is_file() for t in m.tests), m.name
+        assert all((ROOT / t.split("::")[0]).is_file() for t in m.tests), m.name

@@ -76,7 +76,8 @@ def run_mutant(m, timeout: float) -> dict:
                     "seconds": 0.0}  # fmt: skip
         path.write_text(mutated)
         env = dict(os.environ, PYTHONPATH=str(tmp / "src"),
-                   STABDAE_CACHE_DIR=str(tmp / ".cache"), PYTHONDONTWRITEBYTECODE="1")
+                   STABDAE_CACHE_DIR=str(tmp / ".cache"), PYTHONDONTWRITEBYTECODE="1",
+                   STABDAE_HYPOTHESIS_PROFILE="mutation")
         cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
                "-W", "ignore", *m.tests]  # fmt: skip
         start = time.perf_counter()

@@ -443,3 +443,28 @@ def test_every_setting_that_decides_the_numbers_is_in_the_run_key(tmp_path, monk
     same = [what for what, k in changed.items() if k == base]
     assert not same, f"the run key ignores: {same}"
     assert len(set(changed.values())) == len(changed)
+
+
+def test_progress_counts_every_member_of_every_point(capsys):
+    """The bar's total is points × members, a resumed run starts at the points done, each
+    point's members advance it to its end, and the last point reads ``3/3``; disabled, or
+    with no point to run, nothing is written."""
+    from stabdae.study.run import _Progress
+
+    bar = _Progress(3, 1, 10, True)  # 3 points, 1 done before, 10 members each
+    assert (bar._bar.total, bar._bar.n) == (30, 10)
+    for _ in range(2):
+        bar.members(4, 10)
+        assert bar._bar.n in (14, 24)
+        bar.members(10, 10)
+        bar.point_done()
+    assert bar._bar.n == 30
+    bar.close()
+    assert "grid point 3/3" in capsys.readouterr().err
+    for quiet in (_Progress(3, 0, 10, False), _Progress(0, 0, 10, True)):
+        quiet.members(5, 10)
+        quiet.note("boundary: tau = 0.1 stable")
+        quiet.point_done()
+        quiet.close()
+        assert quiet._bar is None
+    assert capsys.readouterr().err == ""
