@@ -220,21 +220,23 @@ def boundary(
         if not decided:
             reason = PROBE_UNDECIDED
         # the full ensemble at the largest stable step; where it fails, step down
-        # (doubling the step) until it passes, then bisect again with the full ensemble
+        # (doubling the step, the last step down to the bracket's low end itself) until
+        # it passes, then bisect again with the full ensemble
         elif (v := probe(good, members, CONFIRM)[0]) == V_UNDECIDED:
             reason = PROBE_UNDECIDED
         elif v != V_STABLE:
             bad, width = good, rtol
             for _ in range(MAX_CONFIRM):
-                if bad / (1.0 + width) < lo:
-                    good, reason = math.nan, CONFIRM_FAILS
-                    break
-                v, t = probe(bad / (1.0 + width), members, CONFIRM)
+                at_low_end = bad / (1.0 + width) <= lo
+                v, t = probe(lo if at_low_end else bad / (1.0 + width), members, CONFIRM)
                 if v == V_STABLE:
                     good = t
                     break
                 if v == V_UNDECIDED:
                     good, reason = math.nan, PROBE_UNDECIDED
+                    break
+                if at_low_end:  # not stable down to the low end
+                    good, reason = math.nan, CONFIRM_FAILS
                     break
                 bad, width = t, 2.0 * width
             else:

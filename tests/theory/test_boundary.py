@@ -14,7 +14,13 @@ import stabdae
 from conftest import assert_schema, load_scene
 from models.affine import model as affine
 from stabdae import theory
-from stabdae._measures import BRACKETED, CLASSES, HIGH_END_STABLE, LOW_END_FAILS
+from stabdae._measures import (
+    BRACKETED,
+    CLASSES,
+    CONFIRM_FAILS,
+    HIGH_END_STABLE,
+    LOW_END_FAILS,
+)
 from stabdae._schemes import as_scheme
 
 #: f̈ = −100 f − 20 ḟ (ω = 10, ξ = 1: a Jordan block) and ḣ = −10 h
@@ -114,6 +120,44 @@ def test_boundary_allows_the_unstable_fraction_q(q, monkeypatch):
     assert float(ds.tau_star_high) <= float(ds.tau_star_low) * (1 + 1e-4)
     if q > 0:  # a stable probe with unstable members: q decided it
         assert ((frac < 1.0) & (ds.probe_stable.values == 1)).any()
+
+
+def _two_edges(search_edge, full_edge, n_search):
+    """A stand-in ensemble stable up to one step with the search's members and up to
+    another with the full ensemble's (a larger ensemble meets rarer failures)."""
+    import xarray as xr
+
+    def fake(model, law, scheme, tau, t_end, *, members, **kw):
+        edge = search_edge if members == n_search else full_edge
+        u = members if tau > edge else 0
+        return xr.Dataset({"fraction_stable": (members - u) / members,
+                           "fraction_stable_low": 0.0, "fraction_stable_high": 1.0,
+                           "members_run": members, "members_stable": members - u,
+                           "members_unstable": u, "members_undecided": 0,
+                           "members_diverged": 0, "members_growing": u})  # fmt: skip
+    return fake
+
+
+@pytest.mark.parametrize("full_edge, reason", [(0.12, BRACKETED), (0.09, CONFIRM_FAILS)])
+def test_the_full_ensemble_steps_down_to_the_brackets_low_end(full_edge, reason,
+                                                               monkeypatch):
+    """The search's members are stable up to τ = 0.3, the full ensemble only up to
+    ``full_edge``: the confirmation steps down from the search's bracket (doubling its
+    step) to the low end τ = 0.1 and no further; above it, the full ensemble's edge is
+    bisected; below it, the search ends with ``CONFIRM_FAILS`` and no τ*."""
+    from stabdae import _boundary
+
+    monkeypatch.setattr(_boundary, "ensemble", _two_edges(0.3, full_edge, 20))
+    ds = stabdae.boundary(affine, AFFINE_LAW, "euler", tau=(0.1, 1.0), rtol=1e-3,
+                          members=40, search_members=20, steps=50)  # fmt: skip
+    assert int(ds.tau_star_reason) == reason
+    confirm = ds.probe_members.values == 40
+    assert ds.probe_tau.values[confirm].min() >= 0.1
+    if reason == BRACKETED:
+        assert float(ds.tau_star_low) <= full_edge < float(ds.tau_star_high)
+        assert float(ds.tau_star_high) <= float(ds.tau_star_low) * (1 + 1e-3)
+    else:
+        assert math.isnan(float(ds.tau_star))
 
 
 def test_boundary_errors():
