@@ -142,10 +142,11 @@ def test_roundoff_level_of_a_moving_constraint_in_closed_form():
         return (X[:, :1] - c * at).copy()
 
     states = np.array([[0.5, 7.0], [2.0, -1.0], [-4.0, 0.0]])
-    got = _measures.roundoff_level(rows, states, t)
-    want = U * float(np.median(np.abs(states[:, 0]) + abs(c * t)))
-    assert got == pytest.approx(want, rel=1e-8)
-    assert _measures.roundoff_level(rows, states, 0.0) == pytest.approx(U * 2.0, rel=1e-8)
+    # in units of u (pytest.approx's default absolute tolerance, 1e-12, would pass any
+    # level of a few u)
+    got = _measures.roundoff_level(rows, states, t) / U
+    assert got == pytest.approx(float(np.median(np.abs(states[:, 0]) + abs(c * t))), rel=1e-8)
+    assert _measures.roundoff_level(rows, states, 0.0) / U == pytest.approx(2.0, rel=1e-8)
 
 
 @given(st.lists(st.lists(st.floats(-50.0, 50.0), min_size=3, max_size=3), min_size=1,

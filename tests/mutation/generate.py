@@ -55,6 +55,8 @@ GROUPS = {
     "decay": ([S + f"engine/decay/{f}.py" for f in ("fit", "ladder", "member", "onestep",
                                                    "traces")],
               ("tests/engine/test_decay_reference.py", D + "test_verdict_reference.py",
+               D + "test_measurement.py::test_beta_of_velocity_and_position_constraints"
+               "_together_matches_the_prediction",
                "tests/engine/test_decay.py", D + "test_measurement.py")),
     "boundary": ([S + "_boundary.py"], ("tests/theory/test_boundary.py",)),
     "theory": ([S + "theory.py"],
