@@ -113,8 +113,6 @@ def _silent_nodes(tree) -> set[int]:
                 mark(node.returns)
             for d in node.decorator_list:
                 mark(d)
-        elif isinstance(node, ast.Global):
-            mark(node)
     return out
 
 
@@ -225,11 +223,12 @@ def candidates(path: Path) -> list[tuple[int, int, str, str, str]]:
     return out
 
 
-def _changes_code(text: str, m: Mutant) -> bool:
-    """The mutated file parses and its syntax tree differs (no change inside a string)."""
+def _changes_code(text: str, tree: str, m: Mutant) -> bool:
+    """The mutated file parses and its syntax tree differs from ``tree`` (the file's,
+    dumped): no change inside a string."""
     mutated = m.apply(text)
     try:
-        return mutated is not None and ast.dump(ast.parse(mutated)) != ast.dump(ast.parse(text))
+        return mutated is not None and ast.dump(ast.parse(mutated)) != tree
     except SyntaxError:
         return False
 
@@ -241,6 +240,7 @@ def generate(seed: int, per_group: int) -> list[Mutant]:
     out = []
     for group, (files, tests) in GROUPS.items():
         texts = {f: (ROOT / f).read_text() for f in files}
+        trees = {f: ast.dump(ast.parse(texts[f])) for f in files}
         pool = [(f, c) for f in files for c in candidates(ROOT / f)]
         rng.shuffle(pool)
         lines_used = set()
@@ -250,7 +250,7 @@ def generate(seed: int, per_group: int) -> list[Mutant]:
             stem = Path(f).stem.lstrip("_")
             m = Mutant(f"g{seed}-{group}-{stem}-{line}", f, old, new, tests, what, line=line,
                        col=col)  # fmt: skip
-            if not _changes_code(texts[f], m):
+            if not _changes_code(texts[f], trees[f], m):
                 continue
             lines_used.add((f, line))
             out.append(m)

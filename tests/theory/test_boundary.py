@@ -84,18 +84,17 @@ def test_boundary_says_when_the_bracket_does_not_hold_it():
     assert float(low.tau_star_low) == 2e-3 and low.sizes["probe"] == 2
 
 
-def _fraction_law(tau0, tau1):
-    """A stand-in for the ensemble a probe runs: of ``n`` members, ``⌊n x⌋`` unstable and
-    the rest stable, ``x = (τ − τ0)/(τ1 − τ0)`` clipped to [0, 1]."""
+def _stand_in(unstable):
+    """A stand-in for the ensemble a probe runs: of its ``members``,
+    ``unstable(tau, members)`` unstable and the rest stable."""
     import xarray as xr
 
     def fake(model, law, scheme, tau, t_end, *, members, **kw):
-        x = min(1.0, max(0.0, (tau - tau0) / (tau1 - tau0)))
-        u = math.floor(members * x)
-        s = members - u
-        return xr.Dataset({"fraction_stable": s / members, "fraction_stable_low": 0.0,
-                           "fraction_stable_high": 1.0, "members_run": members,
-                           "members_stable": s, "members_unstable": u, "members_undecided": 0,
+        u = unstable(tau, members)
+        return xr.Dataset({"fraction_stable": (members - u) / members,
+                           "fraction_stable_low": 0.0, "fraction_stable_high": 1.0,
+                           "members_run": members, "members_stable": members - u,
+                           "members_unstable": u, "members_undecided": 0,
                            "members_diverged": 0, "members_growing": u})  # fmt: skip
     return fake
 
@@ -108,7 +107,9 @@ def test_boundary_allows_the_unstable_fraction_q(q, monkeypatch):
     ``τ = 0.1 + 0.4 (⌊q n⌋ + 1)/n``."""
     from stabdae import _boundary
 
-    monkeypatch.setattr(_boundary, "ensemble", _fraction_law(0.1, 0.5))
+    # of n members, ⌊n x⌋ unstable, x = (τ − 0.1)/0.4 clipped to [0, 1]
+    rising = _stand_in(lambda tau, n: math.floor(n * min(1.0, max(0.0, (tau - 0.1) / 0.4))))
+    monkeypatch.setattr(_boundary, "ensemble", rising)
     n = 40
     ds = stabdae.boundary(affine, AFFINE_LAW, "euler", tau=(0.01, 1.0), rtol=1e-4,
                           members=n, search_members=20, q=q, steps=50)  # fmt: skip
@@ -122,22 +123,6 @@ def test_boundary_allows_the_unstable_fraction_q(q, monkeypatch):
         assert ((frac < 1.0) & (ds.probe_stable.values == 1)).any()
 
 
-def _two_edges(search_edge, full_edge, n_search):
-    """A stand-in ensemble stable up to one step with the search's members and up to
-    another with the full ensemble's (a larger ensemble meets rarer failures)."""
-    import xarray as xr
-
-    def fake(model, law, scheme, tau, t_end, *, members, **kw):
-        edge = search_edge if members == n_search else full_edge
-        u = members if tau > edge else 0
-        return xr.Dataset({"fraction_stable": (members - u) / members,
-                           "fraction_stable_low": 0.0, "fraction_stable_high": 1.0,
-                           "members_run": members, "members_stable": members - u,
-                           "members_unstable": u, "members_undecided": 0,
-                           "members_diverged": 0, "members_growing": u})  # fmt: skip
-    return fake
-
-
 @pytest.mark.parametrize("full_edge, reason", [(0.12, BRACKETED), (0.09, CONFIRM_FAILS)])
 def test_the_full_ensemble_steps_down_to_the_brackets_low_end(full_edge, reason,
                                                                monkeypatch):
@@ -147,7 +132,10 @@ def test_the_full_ensemble_steps_down_to_the_brackets_low_end(full_edge, reason,
     bisected; below it, the search ends with ``CONFIRM_FAILS`` and no τ*."""
     from stabdae import _boundary
 
-    monkeypatch.setattr(_boundary, "ensemble", _two_edges(0.3, full_edge, 20))
+    # every member stable up to one step with the search's 20 members, up to another with
+    # the full ensemble's 40 (a larger ensemble meets rarer failures)
+    edges = _stand_in(lambda tau, n: n if tau > (0.3 if n == 20 else full_edge) else 0)
+    monkeypatch.setattr(_boundary, "ensemble", edges)
     ds = stabdae.boundary(affine, AFFINE_LAW, "euler", tau=(0.1, 1.0), rtol=1e-3,
                           members=40, search_members=20, steps=50)  # fmt: skip
     assert int(ds.tau_star_reason) == reason
