@@ -5,6 +5,11 @@
 with nonlinear forces.  The residual g = (f, ḟ, h) is then affine in (x, t), so one
 explicit Runge–Kutta step maps it exactly by the scheme's stability polynomial:
 g_{k+1} = R(τÃ) g_k, up to roundoff (the discrete theory holds with equality).
+
+``forced`` adds ``FORCING · t²/2`` to f.  Under Euler the step then makes the constant
+remainder ``g_{k+1} − (I + τÃ) g_k = (FORCING τ²/2, 0, 0)`` (f picks up the t² term's
+second-order part, ḟ and h stay affine in (x, t)): the setting of Theorem 6 with
+constant forcing, in closed form.
 """
 
 from __future__ import annotations
@@ -81,6 +86,43 @@ model = stabdae.Model(
     f_q=f_q,
     f_t=f_t,
     f_accel=f_accel,
+    h=h,
+    h_q=h_q,
+    h_v=h_v,
+    h_t=h_t,
+)
+
+
+#: the coefficient of t²/2 in the forced variant's f
+FORCING = 0.04
+
+
+@njit
+def f_forced(t, q, p, out):
+    out[0] = q[0] + 2.0 * q[1] - 0.5 * t - 1.0 + 0.5 * FORCING * t * t
+
+
+@njit
+def f_t_forced(t, q, p, out):
+    out[0] = -0.5 + FORCING * t
+
+
+@njit
+def f_accel_forced(t, q, v, p, out):
+    out[0] = FORCING
+
+
+forced = stabdae.Model(
+    "affine_forced",
+    n=3,
+    m=1,
+    k=1,
+    reference_state=np.array([1.0, 0.0, 0.0, 0.5, 0.0, 0.5 / 3.0]),
+    forces=forces,
+    f=f_forced,
+    f_q=f_q,
+    f_t=f_t_forced,
+    f_accel=f_accel_forced,
     h=h,
     h_q=h_q,
     h_v=h_v,

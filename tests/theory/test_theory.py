@@ -267,6 +267,43 @@ def test_along_path_floor_bounds_the_residual():
         assert (out.norm_max.values > 1.0).all()
 
 
+def test_along_path_with_a_non_symmetric_map_and_constant_forcing():
+    """Theorem 6 in closed form: the forced affine system under Euler makes the remainder
+    ``e = (c τ²/2, 0, 0)`` at every step, with the non-symmetric ``R = I + τÃ`` of a
+    Jordan block (ρ = 0.8, ‖R‖₂ > 1).  ``along_path`` must report that remainder, ``q``
+    and ``ε`` from the weight's definition (``RᵀXR − X = −I`` as a Kronecker system,
+    ``P = X^{1/2}``), and the orbit must settle on the fixed point ``(I − R)⁻¹ e`` below
+    the bound."""
+    from scipy.linalg import sqrtm
+
+    from models.affine import FORCING, forced
+
+    law = stabdae.matrix([[-100.0, -20.0, 0.0], [0.0, 0.0, -10.0]])
+    tau = 0.02
+    x0 = stabdae.sample_perturbations(forced, 1, (1e-3, 1e-3), seed=4)[0][0]
+    path = stabdae.integrate(forced, x0, law, "euler", tau, 4.0, tau)
+    out = theory.along_path(forced, law, "euler", path)
+    R = np.eye(3) + tau * law.A_tilde(forced)
+    e = np.array([0.5 * FORCING * tau**2, 0.0, 0.0])
+    X = np.linalg.solve(np.kron(R.T, R.T) - np.eye(9), -np.eye(3).ravel()).reshape(3, 3)
+    P = np.real(sqrtm(0.5 * (X + X.T)))
+    Pinv = np.linalg.inv(P)
+    q = np.linalg.norm(P @ R @ Pinv, 2)
+    assert np.linalg.norm(R, 2) > 1.0 > q
+    assert np.allclose(out.spectral_radius.values, 0.8, rtol=1e-12)
+    assert np.allclose(out.remainder.values[:-1], e[0], rtol=1e-6)
+    assert float(out.q) == pytest.approx(q, rel=1e-9)
+    eps = np.linalg.norm(Pinv, 2) * np.linalg.norm(P @ e) / (1.0 - q)
+    assert float(out.epsilon) == pytest.approx(eps, rel=1e-6)
+    g0 = path.residual.values[0]
+    assert float(out.bound_start) == pytest.approx(np.linalg.norm(Pinv, 2) *
+                                                   np.linalg.norm(P @ g0), rel=1e-9)  # fmt: skip
+    bound = max(float(out.bound_start), float(out.epsilon))
+    assert (out.residual_norm.values <= bound).all()
+    fixed = np.linalg.solve(np.eye(3) - R, e)
+    np.testing.assert_allclose(path.residual.values[-1], fixed, rtol=1e-6, atol=1e-15)
+
+
 def test_predictions_memo_gives_the_computed_values_per_tau_and_law():
     """The ensemble's predictions are memoized by (Ã, tableau, τ): a repeated call returns
     what a fresh computation gives, a new τ or gain is a new entry, and a caller that
