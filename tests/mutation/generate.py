@@ -63,6 +63,7 @@ GROUPS = {
                (B + "test_recommended_gains_in_closed_form",
                 B + "test_condition4_and_forced_gain_against_closed_forms",
                 B + "test_condition4_with_a_non_symmetric_map_and_constant_forcing",
+                D + "test_adaptive_ensemble.py::test_expm_by_products_is_scipys_to_roundoff",
                 "tests/theory/test_theory.py", V + "test_fifth_bounds_in_closed_form",
                 "tests/theory/test_boundary.py")),
     "ensemble": ([S + "_ensemble.py"],

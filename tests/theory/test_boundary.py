@@ -141,6 +141,15 @@ def test_the_full_ensemble_steps_down_to_the_brackets_low_end(full_edge, reason,
     assert int(ds.tau_star_reason) == reason
     confirm = ds.probe_members.values == 40
     assert ds.probe_tau.values[confirm].min() >= 0.1
+    # the step-down's schedule: from the search's bracket, each failed τ divided by
+    # 1 + rtol, 1 + 2 rtol, 1 + 4 rtol, … until that passes below the low end, which is
+    # then probed itself
+    taus = ds.probe_tau.values[confirm]
+    passed = np.flatnonzero(ds.probe_stable.values[confirm] == 1)
+    down = taus[: passed[0] + 1] if reason == BRACKETED else taus
+    assert down[-1] == 0.1 and down[-2] / (1 + 1e-3 * 2 ** (len(down) - 2)) <= 0.1
+    for j, (before, after) in enumerate(zip(down[:-2], down[1:-1])):
+        assert after == pytest.approx(before / (1 + 1e-3 * 2**j), rel=1e-12)
     if reason == BRACKETED:
         assert float(ds.tau_star_low) <= full_edge < float(ds.tau_star_high)
         assert float(ds.tau_star_high) <= float(ds.tau_star_low) * (1 + 1e-3)
