@@ -184,8 +184,8 @@ def transient_peak(R, max_steps: int = 100_000) -> float:
     """``sup_k ‖R^k‖∞``: how far the linear residual recursion ``g_{k+1} = R g_k`` can
     carry a perturbation above its start (1 for a contraction in the max-norm; near
     ``ω/e``-fold growth of ``‖e^{Ãt}‖`` for critically damped Baumgarte at small steps);
-    ``inf`` when the powers grow past ``1e12`` (``ρ(R) ≥ 1``).  The powers are taken until
-    they fall below a millionth of the peak (or ``max_steps``)."""
+    ``inf`` when the powers grow past ``1e12`` (``ρ(R) ≥ 1``).  The powers ``k ≤ max_steps``
+    are taken until they fall below a millionth of the peak."""
     return power_norms(R, max_steps)[0]
 
 

@@ -91,6 +91,11 @@ def test_an_ensemble_too_large_for_memory_is_refused_up_front(monkeypatch):
     with pytest.raises(MemoryError, match="run fewer members"):
         stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 0.1, 1.0, members=1000,
                          save_dt=0.1, traces="all")  # fmt: skip
+    # the same members given as initial states: counted by rows, not by state components
+    x0 = np.tile(model.reference_state(model.param_vector()), (1000, 1))
+    with pytest.raises(MemoryError, match="members = 1000 with 1000 traces"):
+        stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 0.1, 1.0, x0=x0,
+                         save_dt=0.1, traces="all")  # fmt: skip
 
 
 def test_a_study_with_too_many_members_is_refused_when_loaded(tmp_path):

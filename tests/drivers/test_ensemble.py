@@ -221,6 +221,33 @@ def test_reference_residuals_are_those_of_integrate():
     np.testing.assert_array_equal(g, one.residual.values)
 
 
+def test_a_reference_over_the_size_cap_is_left_out_and_the_raw_residual_measured(
+        monkeypatch):  # fmt: skip
+    """Above ``REFERENCE_MAX_ENTRIES`` numbers (steps × components) the reference is not
+    kept: no rows, and each member's decay is read on its raw residual.  On the affine
+    system, whose reference residual is zero to roundoff, the rates are those measured
+    against the reference."""
+    from models.affine import model as affine
+    from stabdae import _ensemble
+    from stabdae._laws import bind_law
+
+    law = stabdae.matrix([[-100.0, -20.0, 0.0], [0.0, 0.0, -10.0]])
+    p, tau, nsteps = affine.param_vector(), 0.01, 300
+    size = (nsteps + 1) * affine.n_residual
+    for cap, rows in ((size, nsteps + 1), (size - 1, 0)):
+        monkeypatch.setattr(_ensemble, "REFERENCE_MAX_ENTRIES", cap)
+        g = _ensemble._reference_residuals(affine, bind_law(law, affine), stabdae.euler(), p,
+                                           affine.t0, tau, nsteps)  # fmt: skip
+        assert g.shape == (rows, affine.n_residual)
+    kw = dict(members=16, seed=3, radius=(1e-4, 1e-2))
+    raw = stabdae.ensemble(affine, law, "euler", tau, nsteps * tau, **kw)
+    monkeypatch.setattr(_ensemble, "REFERENCE_MAX_ENTRIES", 10**9)
+    ref = stabdae.ensemble(affine, law, "euler", tau, nsteps * tau, **kw)
+    assert np.isfinite(ref.beta.values).all()
+    np.testing.assert_allclose(raw.beta.values, ref.beta.values, rtol=1e-6)
+    assert (raw.verdict.values == ref.verdict.values).all()
+
+
 def test_members_stopped_mid_run_keep_their_last_good_state():
     """Euler at τ = 0.25 with ω = 10 is unstable: every member grows until it stops, at a
     step of its own, so the block loses its members one by one and ends with none running.

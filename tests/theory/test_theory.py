@@ -247,6 +247,23 @@ def test_tau_sweep_boundary_matches_the_spectral_radius(scene):
     assert first_bad(predicted) == 4
 
 
+@pytest.mark.parametrize("m", [1, 2, 5, 40])
+def test_power_norms_stop_at_max_steps_in_closed_form(m):
+    """``R = 1.1`` (powers grow, never below a millionth of the peak): the peak is
+    ``sup_{0 ≤ k ≤ m} 1.1^k = 1.1^m`` and the forced gain ``Σ_{k < m} 1.1^k``; a 2 × 2
+    rotation scaled by 1.1 the same in the max-norm of its powers."""
+    peak, total = theory.power_norms(np.array([[1.1]]), m)
+    assert peak == pytest.approx(1.1**m, rel=1e-14)
+    assert total == pytest.approx(sum(1.1**k for k in range(m)), rel=1e-14)
+    c, s = math.cos(0.3), math.sin(0.3)
+    R = 1.1 * np.array([[c, -s], [s, c]])
+    norms = [np.abs(np.linalg.matrix_power(R, k)).sum(axis=1).max() for k in range(m + 1)]
+    peak, total = theory.power_norms(R, m)
+    assert peak == pytest.approx(max(norms), rel=1e-12)
+    assert total == pytest.approx(sum(norms[:m]), rel=1e-12)
+    assert theory.transient_peak(R, m) == peak and theory.forced_gain(R, m) == total
+
+
 def test_along_path_floor_bounds_the_residual():
     """Theorem 6 along a nonlinear path: ‖g_k‖ ≤ max(‖P⁻¹‖‖Pg₀‖, ε) with ε from the
     measured one-step remainders."""
