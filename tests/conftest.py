@@ -31,6 +31,29 @@ settings.register_profile("mutation", parent=settings.get_profile("stabdae"),
                           phases=[Phase.explicit, Phase.reuse, Phase.generate])  # fmt: skip
 settings.load_profile(os.environ.get("STABDAE_HYPOTHESIS_PROFILE", "stabdae"))
 
+_approx = pytest.approx
+
+
+def _approx_that_can_fail(expected, rel=None, abs=None, nan_ok=False):
+    """``pytest.approx`` refusing a comparison that cannot fail: without ``abs=``, its
+    absolute tolerance of 1e-12 passes anything near an expected value below
+    ``1e-12 / rel`` (a roundoff level of 1e-16, say), whatever the relative tolerance."""
+    if abs is None:
+        try:
+            size = np.abs(np.asarray(expected, dtype=float))
+        except (TypeError, ValueError):
+            size = None
+        small = 1e-12 / (1e-6 if rel is None else rel)
+        if size is not None and np.any((size > 0) & (size < small)):
+            raise AssertionError(
+                f"pytest.approx({expected!r}) without abs=: the default absolute tolerance "
+                "1e-12 would pass any value near it; compare in units, or give abs="
+            )
+    return _approx(expected, rel=rel, abs=abs, nan_ok=nan_ok)
+
+
+pytest.approx = _approx_that_can_fail
+
 ROOT = Path(__file__).resolve().parents[1]
 KERNELS = ROOT / "kernels"
 

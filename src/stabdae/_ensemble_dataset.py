@@ -118,6 +118,7 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
     attrs["verdict_summary"] = _measures.verdict_summary(verdicts, why, cls != _measures.NOT_RUN)
     if referee is not None:
         attrs["reference_floor"] = np.asarray(referee["floor_band"], dtype=float)
+    attrs["roundoff_level"] = float(roundoff)
     attrs["residual_norm_dtype"] = str(norms.dtype)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 

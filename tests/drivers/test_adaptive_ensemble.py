@@ -169,6 +169,32 @@ def test_adaptive_ensemble_isolates_divergence():
     assert a.status.values[1] == stabdae.Status.SINGULAR_S and a.diverged.values[1] == 1
 
 
+@pytest.mark.parametrize("pair, stages", [("dopri5", 7), ("dop853", 13)])
+def test_adaptive_counts_in_closed_form_at_every_stop(pair, stages):
+    """The counts ``integrate_adaptive`` reports on every way out of its loop: stopped by
+    ``max_steps``, accepted plus rejected steps are ``max_steps`` and the right-hand side
+    was evaluated once at the start, once for the first step's estimate and ``s − 1``
+    times per step tried (first same as last); stopped at the start (a singular ``S``),
+    no step and the one evaluation that failed."""
+    import warnings
+
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stabdae.IntegrationWarning)
+        for cap in (1, 2, 9):
+            ds = stabdae.integrate_adaptive(model, None, law, 2.0, scheme=pair, rtol=1e-10,
+                                            atol=1e-12, max_steps=cap)  # fmt: skip
+            tried = ds.attrs["steps_accepted"] + ds.attrs["steps_rejected"]
+            assert int(ds.attrs["status"]) == stabdae.Status.MAX_STEPS and tried == cap
+            assert ds.attrs["rhs_evaluations"] == 2 + (stages - 1) * cap
+        ds = stabdae.integrate_adaptive(model, np.array([0.0, 0.0, 0.1, 0.0]), law, 2.0,
+                                        scheme=pair, rtol=1e-8)  # fmt: skip
+    assert int(ds.attrs["status"]) == stabdae.Status.SINGULAR_S
+    assert (ds.attrs["steps_accepted"], ds.attrs["steps_rejected"],
+            ds.attrs["rhs_evaluations"]) == (0, 0, 1)  # fmt: skip
+
+
 def test_adaptive_ensemble_errors():
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0)

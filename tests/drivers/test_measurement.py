@@ -315,12 +315,39 @@ def test_roundoff_level_of_the_pendulum_is_its_closed_form():
     x, y, vx, vy = X.T
     each = np.maximum(2.0 * (x * x + y * y), 4.0 * (np.abs(x * vx) + np.abs(y * vy)))
     got = _measures.roundoff_level(rows, X, 0.7)
-    assert got == pytest.approx(u * np.median(each), rel=1e-6)
+    # in units of u: pytest.approx's default absolute tolerance (1e-12) passes any level
+    assert got / u == pytest.approx(np.median(each), rel=1e-6)
     assert calls == [5 * 9, 5]  # the differences of every state, then the time shifts
     for i in range(5):
-        assert _measures.roundoff_level(rows, X[i : i + 1], 0.7) == pytest.approx(
-            u * each[i], rel=1e-6)
+        assert _measures.roundoff_level(rows, X[i : i + 1], 0.7) / u == pytest.approx(
+            each[i], rel=1e-6)
     assert _measures.roundoff_level(rows, X[:0], 0.7) == 0.0
+
+
+def test_the_ensembles_roundoff_level_is_the_reference_at_the_end_of_the_run():
+    """The roundoff level an ensemble's verdicts allow for (its attribute
+    ``roundoff_level``): on the affine system, whose constraints move with time
+    (∂f/∂t = −1/2, ∂h/∂t = −1/10), the plain reference's level from the exact derivatives
+    at the members' final states and the run's final time, times the law's
+    ``Σ_k ‖R(τÃ)ᵏ‖∞`` over the run."""
+    from models.affine import model as affine
+    from reference.verdicts import roundoff_level
+    from stabdae import theory
+
+    law = stabdae.matrix([[-100.0, -20.0, 0.0], [0.0, 0.0, -10.0]])
+    tau, nsteps = 0.01, 250
+    ds = stabdae.ensemble(affine, law, "euler", tau, nsteps * tau, members=8, seed=2,
+                          save_dt=0.1)  # fmt: skip
+    grad_x = np.array([[1.0, 2.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0, 2.0, 0.0],
+                       [0.0, 0.2, 0.0, 1.0, 0.0, -3.0]])  # fmt: skip
+    grad_t = np.array([-0.5, 0.0, -0.1])
+    t_end = float(ds.time.values[-1])
+    assert t_end == pytest.approx(nsteps * tau, rel=1e-12)
+    level = roundoff_level(None, lambda x, t: grad_x, lambda x, t: grad_t,
+                           ds.x_final.values, t_end)  # fmt: skip
+    gain = theory.forced_gain(np.eye(3) + tau * law.A_tilde(affine), nsteps)
+    # (abs=0: pytest.approx would otherwise pass anything within 1e-12 of a level ~1e-13)
+    assert ds.attrs["roundoff_level"] == pytest.approx(level * gain, rel=1e-6, abs=0.0)
 
 
 def test_beta_of_velocity_and_position_constraints_together_matches_the_prediction():

@@ -307,8 +307,8 @@ def test_along_path_with_a_non_symmetric_map_and_constant_forcing():
     Pinv = np.linalg.inv(P)
     q = np.linalg.norm(P @ R @ Pinv, 2)
     assert np.linalg.norm(R, 2) > 1.0 > q
-    assert np.allclose(out.spectral_radius.values, 0.8, rtol=1e-12)
-    assert np.allclose(out.remainder.values[:-1], e[0], rtol=1e-6)
+    assert np.allclose(out.spectral_radius.values, 0.8, rtol=1e-12, atol=0.0)
+    assert np.allclose(out.remainder.values[:-1], e[0], rtol=1e-6, atol=0.0)
     assert float(out.q) == pytest.approx(q, rel=1e-9)
     eps = np.linalg.norm(Pinv, 2) * np.linalg.norm(P @ e) / (1.0 - q)
     assert float(out.epsilon) == pytest.approx(eps, rel=1e-6)
