@@ -174,3 +174,28 @@ def test_a_norm_over_components_of_different_units_says_so():
     assert gamma["comment"].startswith("max over residual components of different units")
     one = schema_variable("residual_norm", 0.0, sleigh, dims=()).attrs
     assert one["units"] == "m s-1" and "different units" not in one.get("comment", "")
+
+
+def test_write_netcdf_compresses_the_numeric_arrays_at_the_level_asked(tmp_path):
+    """``write_netcdf``: floating-point and integer arrays zlib-compressed (with the
+    shuffle filter) at level ``compress``, scalars and strings as they are; the values
+    read back equal."""
+    import netCDF4
+    import numpy as np
+    import xarray as xr
+
+    from stabdae._schema import write_netcdf
+
+    ds = xr.Dataset({"rate": ("member", np.linspace(0.0, 1.0, 50)),
+                     "count": ("member", np.arange(50, dtype=np.int32)),
+                     "label": ("member", np.array([f"m{i}" for i in range(50)])),
+                     "scalar": ((), 2.5)})  # fmt: skip
+    path = write_netcdf(ds, tmp_path / "a.nc", compress=7)
+    with netCDF4.Dataset(path) as nc:
+        for name in ("rate", "count"):
+            filters = nc[name].filters()
+            assert filters["zlib"] and filters["shuffle"] and filters["complevel"] == 7, name
+        for name in ("label", "scalar"):
+            assert not nc[name].filters()["zlib"], name
+    back = xr.open_dataset(path).load()
+    xr.testing.assert_identical(back.drop_attrs(), ds.drop_attrs())

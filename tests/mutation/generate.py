@@ -72,7 +72,9 @@ GROUPS = {
     "adaptive": ([S + "engine/rk/adaptive.py", S + "engine/ensemble/lanes.py"],
                  (D + "test_adaptive_ensemble.py", D + "test_hard_cases.py")),
     "sparsity": ([S + "engine/sparsity.py"], ("tests/engine/test_sparsity.py",)),
-    "study": ([S + "study/run.py"], ("tests/study/test_run.py", "tests/study/test_cli.py")),
+    "study": ([S + "study/run.py"],
+              ("tests/study/test_run.py", "tests/study/test_cli.py",
+               "tests/study/test_study.py::test_a_theorem5_search_study_has_no_path_theory")),
     "schema": ([S + "_schema.py"], (D + "test_schema.py", "tests/meta/test_docs.py")),
 }  # fmt: skip
 

@@ -423,6 +423,26 @@ def test_search_study_finds_the_boundary_per_point_and_plots_it(tmp_path):
     assert [p.name for p in pictures] == ["pic_boundary.png"] and pictures[0].stat().st_size
 
 
+def test_a_theorem5_search_study_has_no_path_theory(tmp_path):
+    """A [search] study of a state-dependent law (Theorem 5 on the sleigh): one boundary
+    per value of the other axis; the conditions along the reference path belong to a
+    grid of steps and are not computed for a searched step (they are, per τ, in a swept
+    study of the same law)."""
+    from stabdae.study.run import run_study
+
+    text = (SEARCH.replace('file = "pendulum"', 'file = "chaplygin_sleigh"')
+            .replace('kind = "baumgarte"\nomega = 10.0\nxi = 1.0', 'kind = "theorem5"\nk = 4.0')
+            .replace("members = 16", "members = 8").replace("search_members = 8",
+                                                            "search_members = 4")
+            .replace("steps = 2000", "steps = 100").replace("rtol = 0.05", "rtol = 0.3")
+            .replace("omega = [10.0, 100.0]", "k = [4.0]"))  # fmt: skip
+    out = run_study(load_study(write(tmp_path, text)), tmp_path / "s.nc", progress=False,
+                    log=lambda line: None)  # fmt: skip
+    ds = xr.open_dataset(out).load()
+    assert ds.tau_star.dims == ("k",) and np.isfinite(ds.tau_star_low).all()
+    assert not [v for v in ds.data_vars if v.startswith("path_")]
+
+
 @pytest.mark.parametrize("edit, message", [
     (("steps = 2000", "steps = 2000\nt_end = 2.0"), r"\[search\] t_end: give steps or t_end"),
     (("bisect = [1e-3, 3.0]", "bisect = [3.0, 1e-3]"), r"\[search\] tau.bisect: needs 0 < low"),
