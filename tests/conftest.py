@@ -35,16 +35,15 @@ _approx = pytest.approx
 
 
 def _approx_that_can_fail(expected, rel=None, abs=None, nan_ok=False):
-    """``pytest.approx`` refusing a comparison that cannot fail: without ``abs=``, its
-    absolute tolerance of 1e-12 passes anything near an expected value below
-    ``1e-12 / rel`` (a roundoff level of 1e-16, say), whatever the relative tolerance."""
+    """``pytest.approx`` refusing a comparison that can hardly fail: without ``abs=``, its
+    absolute tolerance of 1e-12 passes a change of more than a thousandth of an expected
+    value below 1e-9 (a roundoff level of 1e-16, say), whatever the relative tolerance."""
     if abs is None:
         try:
             size = np.abs(np.asarray(expected, dtype=float))
         except (TypeError, ValueError):
             size = None
-        small = 1e-12 / (1e-6 if rel is None else rel)
-        if size is not None and np.any((size > 0) & (size < small)):
+        if size is not None and np.any((size > 0) & (size < 1e-9)):
             raise AssertionError(
                 f"pytest.approx({expected!r}) without abs=: the default absolute tolerance "
                 "1e-12 would pass any value near it; compare in units, or give abs="

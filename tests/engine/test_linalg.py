@@ -91,7 +91,7 @@ def test_pivot_rule_is_relative_to_the_matrix_scale(scale):
     assert ldl_inplace(near.copy(), 2, 1e-12) == 2
 
 
-@pytest.mark.parametrize("n", [1, 2, 3, 4, 7, 8])
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 8])  # each size is a compilation
 def test_written_out_and_looped_ldl_agree_bit_for_bit(n):
     """The straight-line factor and solves that a dense right-hand side uses for its sizes
     (so that the ensemble kernel's member loop around them vectorizes) do the loops'
