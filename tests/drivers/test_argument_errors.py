@@ -91,6 +91,13 @@ def test_an_ensemble_too_large_for_memory_is_refused_up_front(monkeypatch):
     with pytest.raises(MemoryError, match="run fewer members"):
         stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 0.1, 1.0, members=1000,
                          save_dt=0.1, traces="all")  # fmt: skip
+    # no traces stored: none counted, and exactly what the members need is enough
+    exact = _validate.ensemble_bytes(model.n, model.n_residual, 1000, 0, 11, 4)
+    monkeypatch.setattr(_validate, "available_memory", lambda: exact)
+    ds = stabdae.ensemble(model, stabdae.baumgarte(10.0), "midpoint", 0.1, 1.0, members=1000,
+                          save_dt=0.1, traces="none")  # fmt: skip
+    assert ds.sizes["member"] == 1000
+    monkeypatch.setattr(_validate, "available_memory", lambda: need - 1)
     # the same members given as initial states: counted by rows, not by state components
     x0 = np.tile(model.reference_state(model.param_vector()), (1000, 1))
     with pytest.raises(MemoryError, match="members = 1000 with 1000 traces"):
