@@ -112,19 +112,5 @@ def f_accel_forced(t, q, v, p, out):
     out[0] = FORCING
 
 
-forced = stabdae.Model(
-    "affine_forced",
-    n=3,
-    m=1,
-    k=1,
-    reference_state=np.array([1.0, 0.0, 0.0, 0.5, 0.0, 0.5 / 3.0]),
-    forces=forces,
-    f=f_forced,
-    f_q=f_q,
-    f_t=f_t_forced,
-    f_accel=f_accel_forced,
-    h=h,
-    h_q=h_q,
-    h_v=h_v,
-    h_t=h_t,
-)
+forced = model.replace(name="affine_forced", f=f_forced, f_t=f_t_forced,
+                       f_accel=f_accel_forced)
