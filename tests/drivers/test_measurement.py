@@ -343,8 +343,8 @@ def test_the_ensembles_roundoff_level_is_the_reference_at_the_end_of_the_run():
     grad_t = np.array([-0.5, 0.0, -0.1])
     t_end = float(ds.time.values[-1])
     assert t_end == pytest.approx(nsteps * tau, rel=1e-12)
-    level = roundoff_level(None, lambda x, t: grad_x, lambda x, t: grad_t,
-                           ds.x_final.values, t_end)  # fmt: skip
+    level = roundoff_level(lambda x, t: grad_x, lambda x, t: grad_t, ds.x_final.values,
+                           t_end)  # fmt: skip
     gain = theory.forced_gain(np.eye(3) + tau * law.A_tilde(affine), nsteps)
     # (abs=0: pytest.approx would otherwise pass anything within 1e-12 of a level ~1e-13)
     assert ds.attrs["roundoff_level"] == pytest.approx(level * gain, rel=1e-6, abs=0.0)

@@ -169,7 +169,7 @@ def test_roundoff_level_is_the_references(states, t):
         return np.array([0.0, -math.cos(at) * x[0]])
 
     got = _measures.roundoff_level(rows, states, t)
-    want = ref.roundoff_level(rows, grad_x, grad_t, states, t)
+    want = ref.roundoff_level(grad_x, grad_t, states, t)
     assert got == pytest.approx(want, rel=1e-2, abs=U * 1e-6)
 
 

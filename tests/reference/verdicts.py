@@ -55,17 +55,13 @@ def grows(d2: float, d3: float, d4: float) -> bool:
     return d2 <= d3 <= d4 and d4 > GROWTH * d2
 
 
-def _finite(x: float) -> bool:
-    return math.isfinite(x)
-
-
 def verdict(d0, d2, d3, d4, status, floor_band=None, bounds=None, rho=math.nan,
             divergence=math.inf, roundoff=0.0) -> tuple[int, int]:  # fmt: skip
     """One member's ``(verdict, reason)``."""
     band = [0.0] * 5 if floor_band is None else [0.0 if math.isnan(b) else b
                                                   for b in floor_band]  # fmt: skip
     noise = [FLOOR_BAND * b + ROUNDOFF_MARGIN * roundoff for b in band]
-    theory = bounds is not None and _finite(rho)
+    theory = bounds is not None and math.isfinite(rho)
     status = int(status)
     blown = status in {int(s) for s in BLOWN_UP}
     if status != 0 and not blown:
@@ -76,7 +72,7 @@ def verdict(d0, d2, d3, d4, status, floor_band=None, bounds=None, rho=math.nan,
             if divergence <= peak:
                 return V.UNDECIDED, R.STOPPED_IN_TRANSIENT
         return V.UNSTABLE, R.BLEW_UP
-    resolved = _finite(d2) and _finite(d3) and _finite(d4)
+    resolved = math.isfinite(d2) and math.isfinite(d3) and math.isfinite(d4)
     rising = resolved and grows(d2, d3, d4)
     if theory and rho < 1.0:
         if d4 <= TRANSIENT_SLACK * bounds[4] * d0 + noise[4]:
@@ -127,7 +123,7 @@ def ensemble_verdict(n_run: int, n_stable: int, n_unstable: int, q: float) -> in
     return V.UNSTABLE if n_unstable > q * n_run else V.UNDECIDED
 
 
-def roundoff_level(g, grad_x, grad_t, states, t: float) -> float:
+def roundoff_level(grad_x, grad_t, states, t: float) -> float:
     """``u · median over the states of max_c (Σ_i |∂g_c/∂x_i · x_i| + |∂g_c/∂t · t|)``
     from exact derivatives: ``grad_x(x, t)`` (ng, n), ``grad_t(x, t)`` (ng,); states whose
     terms are not finite are left out (0 where none is left)."""
