@@ -115,7 +115,8 @@ class FitKind(_Codes):
     EXPONENTIAL = 1, "exponential"
     POLYNOMIAL = 2, "exponential with polynomial prefactor"
     OSCILLATING = 3, "oscillating (level times regressed on levels)"
-    MAP = 4, "one-step map (spectral radius of the fitted g_k -> g_k+1)"
+    MAP = 4, ("one-step map (spectral radius of the fitted g_k -> g_k+1; on adaptive steps, "
+              "its generator: the largest real part of the fitted A in dg/dt = A g)")
 
 
 class StabilityClass(_Codes):

@@ -58,6 +58,8 @@ MAX_STEPS = 10_000_000
 DIVERGENCE_OVER_BOUND = 1e3
 #: the largest reference residual history kept (steps × components; 128 MB)
 REFERENCE_MAX_ENTRIES = 16_000_000
+#: rows first allotted to an adaptive reference trajectory's steps (more on a second run)
+REFERENCE_ROWS = 4096
 #: the fixed-step kernel measures the residual at every ``s``-th step, ``s`` at most this
 #: many, over which no mode of the law changes by more than ``STRIDE_CHANGE`` in ``ln``
 #: (:func:`measure_stride`)
@@ -391,18 +393,49 @@ class _Lanes:
         return {"steps_accepted": out.steps, "rhs_evaluations": out.nfev}
 
     def reference(self, run):
-        return None  # each member's steps are its own: no common reference trajectory
+        """The reference trajectory's ``(t, g)`` at its start and every accepted step: a
+        run of the lanes kernel with this one member, which records them (no rows where
+        it does not run to the end or would take more than ``REFERENCE_MAX_ENTRIES``
+        numbers).  Each member's steps are its own, but a member whose steps the motion
+        sets (rather than its transient: every member near its floor) takes nearly the
+        reference's, and with them nearly its local errors: its decay is measured on its
+        distance from this residual, linear in time between the reference's steps."""
+        model = run.model
+        cols = 1 + model.n_residual
+        x0 = model.reference_state(run.p)[None, :]
+        rows = REFERENCE_ROWS
+        while True:
+            out = self._outputs(run, x0, np.zeros(1, dtype=np.int8), rows, cols)
+            measure = AdaptiveMeasurement.of(math.inf, run.R, run.h_pred, np.full(1, -1),
+                                             np.zeros((0, cols)))  # fmt: skip
+            self.kernel(inputs(x0, np.zeros((1, cols - 1)), run.p, run.bound), self.grid,
+                        self.tableau, measure, out, 0, 1)  # fmt: skip
+            need = int(out.steps[0]) + 1
+            if out.status[0] != 0 or need * cols > REFERENCE_MAX_ENTRIES:
+                return np.zeros((0, cols))
+            if need <= rows:
+                table = out.g_out[:need]
+                return table if np.isfinite(table).all() else np.zeros((0, cols))
+            rows = need
 
-    def integrate(self, run, x0, alpha0, status, g_ref) -> Outputs:
-        """The kernel over chunks of members on threads."""
-        M = x0.shape[0]
-        out = outputs(M, x0.shape[1], run.model.n_residual, run.traced.size,
-                      self.grid.save_times.size + 1, run.rdtype, counts=True)  # fmt: skip
+    def _outputs(self, run, x0, status, rows=0, columns=0) -> Outputs:
+        """Outputs for the members ``x0`` (the reference alone: ``rows`` of ``(t, g)``,
+        ``columns`` wide, and no traces)."""
+        out = outputs(x0.shape[0], x0.shape[1], run.model.n_residual,
+                      0 if rows else run.traced.size, self.grid.save_times.size + 1,
+                      run.rdtype, residuals=rows, columns=columns, counts=True)  # fmt: skip
         out.status[:] = status  # members that could not be placed stay out
         out.fail_step.fill(-1)  # (the lanes write these only where a member stops or ends)
         out.e0.fill(np.nan)
         out.e1.fill(np.nan)
-        measure = AdaptiveMeasurement.of(run.divergence, run.R, run.h_pred, run.trace_row)
+        return out
+
+    def integrate(self, run, x0, alpha0, status, g_ref) -> Outputs:
+        """The kernel over chunks of members on threads."""
+        M = x0.shape[0]
+        out = self._outputs(run, x0, status)
+        measure = AdaptiveMeasurement.of(run.divergence, run.R, run.h_pred, run.trace_row,
+                                         g_ref)  # fmt: skip
         args = (inputs(x0, alpha0, run.p, run.bound), self.grid, self.tableau, measure, out)
         run_chunks(lambda lo, hi: self.kernel(*args, lo, hi), M, threads=run.threads,
                    progress=run.progress)  # fmt: skip
@@ -619,10 +652,14 @@ def _referee(run: _RunSpec, g_ref) -> dict:
     alone), and, where ``Ã`` is constant, ``ρ`` of the one-step propagator and
     ``sup ‖R^k‖∞`` per fifth (:func:`.theory.fifth_bounds`)."""
     if g_ref is not None and g_ref.shape[0] > 1:
-        nsteps = g_ref.shape[0] - 1
-        k = np.arange(nsteps + 1)
-        fifth = np.minimum(4, (5 * k) // nsteps)
-        norms = np.abs(np.asarray(g_ref, dtype=float)).max(axis=1)
+        if run.adaptive:  # rows (t, g) at the reference's accepted steps, fifths by time
+            t = g_ref[:, 0]
+            fifth = np.minimum(4, (5.0 * (t - run.t0) / (run.t_end - run.t0)).astype(int))
+            norms = np.abs(g_ref[:, 1:]).max(axis=1)
+        else:
+            nsteps = g_ref.shape[0] - 1
+            fifth = np.minimum(4, (5 * np.arange(nsteps + 1)) // nsteps)
+            norms = np.abs(np.asarray(g_ref, dtype=float)).max(axis=1)
         band = np.array([norms[fifth == w].max(initial=0.0) for w in range(5)])
     else:
         band = _reference_floor(run)

@@ -55,6 +55,18 @@ _LOG_PREFACTOR = (
     'tests/engine/test_decay.py::test_log_prefactor_fit_outside_the_normal_range_is_least_squares',
 )
 
+#: the generator fit on exact flows
+_GENERATOR = tuple(
+    f'tests/engine/test_decay.py::test_generator_fit_gives_the_rate_of_an_exact_flow[{case}]'
+    for case in ("critical", "under", "over", "pooled-two-and-h", "full"))
+
+#: adaptive members' rates down to their floor
+_ADAPTIVE_RATES = (
+    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_member_rates_down_to_their_floor[dopri5-1.0]',
+    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_member_rates_down_to_their_floor[dop853-2.0]',
+    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_samples_change_no_step',
+)
+
 #: the adaptive loop against SciPy's step sequence
 _SCIPY_STEPS = (
     'tests/drivers/test_hard_cases.py::test_adaptive_loop_takes_scipys_steps[1e-06-dopri5-RK45]',
@@ -630,6 +642,44 @@ MUTANTS = [
            ('tests/drivers/test_adaptive_ensemble.py::test_adaptive_prediction_wakes_no_lapack_solve',
             'tests/drivers/test_adaptive_ensemble.py::test_expm_by_products_is_scipys_to_roundoff'),
            "the prediction's propagator e^{Ãh} is e^{Ãh/2} for a scaled matrix"),
+    # ---- the adaptive path's generator fit and its reference trajectory
+    Mutant("generator-pade-sign",
+           E + "decay/onestep.py",
+           "            c10 = y10 + (q10 * s[7] + q11 * s[9]) / 12.0",
+           "            c10 = y10 - (q10 * s[7] + q11 * s[9]) / 12.0",
+           _GENERATOR,
+           "the pooled generator's Padé correction of the ḟ row has the wrong sign"),
+    Mutant("generator-full-no-sweep",
+           E + "decay/onestep.py",
+           "        C = Yr + (Ar @ Ar) @ Zr / 12.0",
+           "        C = Yr",
+           ('tests/engine/test_decay.py::test_generator_fit_gives_the_rate_of_an_exact_flow[full]',),
+           "the full generator keeps the trapezoidal fit (no Padé sweep)"),
+    Mutant("generator-pair-old-state",
+           E + "decay/onestep.py",
+           "    for l in range(ng):\n        G0[j, l] = G1[l, j]",
+           "    for l in range(0):\n        G0[j, l] = G1[l, j]",
+           _GENERATOR + _ADAPTIVE_RATES,
+           "every generator pair starts from the member's first state"),
+    Mutant("adaptive-raw-residual",
+           E + "ensemble/lanes.py",
+           "                        d = _deviation(GN, lane, g_ref, kp, t) if NR > 0 else RN[lane]",
+           "                        d = RN[lane]",
+           _ADAPTIVE_RATES,
+           "adaptive members are measured on their raw residual, not their distance from "
+           "the reference's"),
+    Mutant("adaptive-reference-not-interpolated",
+           E + "ensemble/lanes.py",
+           "        w = min(1.0, max(0.0, (t - g_ref[k, 0]) / (g_ref[k + 1, 0] - g_ref[k, 0])))",
+           "        w = 0.0",
+           _ADAPTIVE_RATES,
+           "the reference's residual is held at its last step instead of interpolated"),
+    Mutant("generator-few-pairs",
+           E + "decay/onestep.py",
+           "            if pairs < MIN_POINTS:",
+           "            if pairs < 2:",
+           _ADAPTIVE_RATES,
+           "the generator takes a window of a handful of pairs"),
     # ---- a reviewer's changes that passed the suite (each now caught by a test that says
     #      what it checks)
     Mutant("growth-middle-dropped",

@@ -44,6 +44,10 @@ The estimator (:func:`estimate`), per member, at the end of its run:
 A member that stopped, or whose envelope does not fall, gets ``β = γ = NaN`` and a reason
 (:data:`REASONS`), never a fitted number.
 
+Where a constant law gives one (:mod:`.onestep`), the rate is read from the one-step map
+fitted to the residual's pairs (fixed steps) or from the generator fitted to its accepted
+steps (adaptive ones), with the envelope's fit as the fallback.
+
 :func:`predict` runs a member's linear prediction ``g_{k+1} = R g_k`` from its own
 ``α⁰`` (``R = R(τÃ)`` for fixed steps, ``e^{Ãh}`` for adaptive ones) through the same
 ladder and fits it over the same time window with the same kind of fit, so that what the
@@ -56,7 +60,8 @@ The package, by role (each module's docstring says more):
 * :mod:`.ladder` — levels from a float's bits, the ladder and its envelope points;
 * :mod:`.fit` — the window and the fits of the envelope; the growth predicate;
 * :mod:`.member` — one member's begin, observe, finish and prediction;
-* :mod:`.onestep` — the one-step map's sums, flushes and spectral radius;
+* :mod:`.onestep` — the one-step map's sums, flushes and spectral radius; the
+  generator's sums and rate for adaptive steps;
 * :mod:`.traces` — the estimator over stored traces.
 """
 
@@ -100,6 +105,7 @@ from .member import (  # noqa: F401
 )
 from .onestep import (  # noqa: F401
     CLUSTER,
+    GENERATOR_SWEEPS,
     MAP_BINS,
     MAP_MARGIN,
     MAP_MAX_NG,
@@ -112,6 +118,9 @@ from .onestep import (  # noqa: F401
     end_flush,
     flushes_for,
     full_rows,
+    generator_add,
+    generator_store,
+    generator_width,
     grouped_radius_of,
     map_begin,
     map_buffers,

@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit
 
 from ..workspace import stack1
-from .fit import FLOOR_MARGIN, MIN_DECADES
+from .fit import FLOOR_MARGIN, MIN_DECADES, MIN_POINTS
 from .ladder import _TINY, LEVELS_PER_OCTAVE, NBINS, ladder_level, log_normal, trailing_zeros
 from .record import (
     C_BETA,
@@ -646,7 +646,7 @@ def _map_gamma(lt, lv, j, lo, top, beta, u):
 
 @njit(cache=True)
 def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref,
-                 lowest=0):  # fmt: skip
+                 lowest=0, gen_h=0.0):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
@@ -661,7 +661,9 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
     span a decade (``MIN_DECADES``) above the cut; a member without such pairs, or whose
     map is singular or has ``ρ ≥ 1``, is left to the envelope's fit
     (:func:`fit_envelope`).
-    ``lowest``: no level below it was visited (γ's pass starts there).  Returns whether
+    ``lowest``: no level below it was visited (γ's pass starts there).  ``gen_h > 0``:
+    ``S`` holds the sums of the generator (adaptive steps, :func:`generator_add`), read
+    on the scale of a step ``gen_h`` (``ref``'s); ``β = −max Re λ(Â)``.  Returns whether
     it gave β."""
     out = meas[row]
     if S.shape[2] == 0:
@@ -675,7 +677,9 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
             top = b
             break
     per_decade = LEVELS_PER_OCTAVE * math.log2(10.0) * MIN_DECADES
-    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN):
+    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, GENERATOR_MARGIN):
+        if margin == GENERATOR_MARGIN and not gen_h > 0.0:
+            break
         if margin < 0.0:  # still decaying: the last fifth's largest norm is no floor
             if not still:
                 continue
@@ -687,11 +691,17 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
         if top - cut < per_decade:
             continue
         first = (cut + (1 << MAP_SHIFT) - 1) >> MAP_SHIFT  # bins wholly above the cut
-        rho, pairs = (_pooled_radius(S, j, first, ref) if pm >= 0
-                      else _map_radius(S, j, ng, first, ref))  # fmt: skip
+        if gen_h > 0.0:
+            rho, pairs = _generator_radius(S, j, ng, pm, first, ref, gen_h)
+            # too few steps above this cut: a lower one has more
+            if pairs < MIN_POINTS:
+                continue
+        else:
+            rho, pairs = (_pooled_radius(S, j, first, ref) if pm >= 0
+                          else _map_radius(S, j, ng, first, ref))  # fmt: skip
         if not (rho < 1.0 and rho > 0.0):
             return False
-        beta = -math.log(rho) / tau
+        beta = -math.log(rho) / (gen_h if gen_h > 0.0 else tau)
         gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta, ry)
         out[C_BETA] = beta
         out[C_GAMMA] = gamma
@@ -704,3 +714,218 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
         code[I_REASON] = R_FITTED
         return True
     return False
+
+
+# --------------------------------------------------------------------- the generator
+# Adaptive steps have no one-step map: each step has its own length.  What all of them
+# share is the generator ``A`` of ``ġ = A g``, which a step of length ``h`` maps by
+# ``e^{hA}``.  Its (2, 2) Padé form ``(I − hA/2 + h²A²/12) g_{k+1} = (I + hA/2 +
+# h²A²/12) g_k`` (exact to ``O((h‖A‖)⁵)`` per step) gives, with ``p = (g_k + g_{k+1})/2``
+# and ``d = g_{k+1} − g_k``,
+#
+#     A p = d/h + (h/12) A² d,
+#
+# linear in ``A`` but for the ``A²`` term: ``A`` is fitted by least squares with it taken
+# from the previous iterate (``GENERATOR_SWEEPS`` sweeps from the trapezoidal fit
+# ``A p = d/h``, whose rates are low by ``(hβ)²/12``), from three running sums per bin:
+# ``Σ p pᵀ``, ``Σ (d/h) pᵀ`` and ``Σ h d pᵀ``.  The rates are ``Re λ(Â)``; the bins are
+# the one-step map's (:func:`map_buffers`: the pairs before the member's level first fell
+# below each bin), and so is the window (:func:`map_estimate`).  The pairs are of the
+# member's distance from the reference trajectory's residual, as the one-step map's: the
+# integrator's local errors hold the residual itself on a floor that moves with the
+# motion, the same for every member whose steps the motion, not its transient, sets.
+
+#: sweeps of the Padé correction of the generator's fit (each multiplies the error of the
+#: trapezoidal fit's ``(hβ)²/12`` by about another ``(hβ)²/12``; the third is past
+#: roundoff for ``hβ < 0.5``)
+GENERATOR_SWEEPS = 3
+GENERATOR_MARGIN = 10.0
+
+
+@njit(cache=True)
+def generator_width(ng, pm):
+    """The generator's sums per bin.  Pooled (``pm ≥ 0`` holonomic constraints, as
+    :func:`map_width`): over ``p = (f_i, ḟ_i)`` ``Σ p pᵀ``'s 3, ``Σ (d/h) pᵀ``'s 4 and ``Σ h
+    d pᵀ``'s 4, the three of the ``h_j`` and the count (15).  Else the full ``ng × ng``
+    sums and the count (none above ``MAP_MAX_NG`` components)."""
+    if pm >= 0:
+        return 15
+    return 3 * ng * ng + 1 if ng <= MAP_MAX_NG else 0
+
+
+@njit(cache=True)
+def generator_add(A, j, G0, G1, h, pm):
+    """The pair of slot ``j``'s residuals ``G0[j]`` (the accepted state before) and
+    ``G1[:, j]`` (the new one), a step ``h`` apart, added to its running sums ``A[j]``
+    (:func:`generator_width`); then ``G0[j] = G1[:, j]``."""
+    ng = G0.shape[1]
+    a = A[j]
+    if a.shape[0] == 0:
+        return
+    if pm >= 0:
+        for i in range(pm):
+            p0 = 0.5 * (G0[j, i] + G1[i, j])
+            p1 = 0.5 * (G0[j, pm + i] + G1[pm + i, j])
+            d0 = G1[i, j] - G0[j, i]
+            d1 = G1[pm + i, j] - G0[j, pm + i]
+            a[0] += p0 * p0
+            a[1] += p0 * p1
+            a[2] += p1 * p1
+            a[3] += d0 / h * p0
+            a[4] += d0 / h * p1
+            a[5] += d1 / h * p0
+            a[6] += d1 / h * p1
+            a[7] += h * d0 * p0
+            a[8] += h * d0 * p1
+            a[9] += h * d1 * p0
+            a[10] += h * d1 * p1
+        for i in range(2 * pm, ng):
+            p = 0.5 * (G0[j, i] + G1[i, j])
+            d = G1[i, j] - G0[j, i]
+            a[11] += p * p
+            a[12] += d / h * p
+            a[13] += h * d * p
+    else:
+        n2 = ng * ng
+        for r in range(ng):
+            pr = 0.5 * (G0[j, r] + G1[r, j])
+            dr = G1[r, j] - G0[j, r]
+            for c in range(ng):
+                pc = 0.5 * (G0[j, c] + G1[c, j])
+                a[r * ng + c] += pr * pc
+                a[n2 + r * ng + c] += dr / h * pc
+                a[2 * n2 + r * ng + c] += h * dr * pc
+    a[a.shape[0] - 1] += 1.0
+    for l in range(ng):
+        G0[j, l] = G1[l, j]
+
+
+@njit(cache=True)
+def generator_store(S, A, j, first, last):
+    """Slot ``j``'s running sums so far as those of bins ``first … last``."""
+    for b in range(first, last + 1):
+        for c in range(A.shape[1]):
+            S[j, b, c] = A[j, c]
+
+
+@njit(cache=True)
+def _generator2(s, ref, h):
+    """``ρ`` equivalent ``e^{h max Re λ(Â)}`` of the pooled generator's sums ``s``
+    (:func:`generator_width`), read in the groups of the law's spectrum ``ref`` (on the
+    scale of a step ``h``: :func:`reference_logs` of ``e^{hÃ}``); −1 where neither block
+    has data."""
+    rho = -1.0
+    det = s[0] * s[2] - s[1] * s[1]
+    if s[0] > 0.0 and s[2] > 0.0 and abs(det) > 1e-14 * s[0] * s[2]:
+        # P⁻¹ (symmetric) and Â = (Y + Â² Z / 12) P⁻¹, Y = [[s3, s4], [s5, s6]], Z = s7…s10
+        i00, i01, i11 = s[2] / det, -s[1] / det, s[0] / det
+        y00, y01, y10, y11 = s[3], s[4], s[5], s[6]
+        a00 = y00 * i00 + y01 * i01
+        a01 = y00 * i01 + y01 * i11
+        a10 = y10 * i00 + y11 * i01
+        a11 = y10 * i01 + y11 * i11
+        for _ in range(GENERATOR_SWEEPS):
+            q00 = a00 * a00 + a01 * a10
+            q01 = a00 * a01 + a01 * a11
+            q10 = a10 * a00 + a11 * a10
+            q11 = a10 * a01 + a11 * a11
+            c00 = y00 + (q00 * s[7] + q01 * s[9]) / 12.0
+            c01 = y01 + (q00 * s[8] + q01 * s[10]) / 12.0
+            c10 = y10 + (q10 * s[7] + q11 * s[9]) / 12.0
+            c11 = y11 + (q10 * s[8] + q11 * s[10]) / 12.0
+            a00 = c00 * i00 + c01 * i01
+            a01 = c00 * i01 + c01 * i11
+            a10 = c10 * i00 + c11 * i01
+            a11 = c10 * i01 + c11 * i11
+        half = 0.5 * (a00 + a11)
+        disc = half * half - (a00 * a11 - a01 * a10)
+        if not (disc == disc) or not math.isfinite(half):
+            return math.nan
+        mod = stack1(2)
+        if disc < 0.0:  # a complex pair: one real part
+            mod[0] = math.exp(h * half)
+            mod[1] = mod[0]
+        else:
+            mod[0] = math.exp(h * (half + math.sqrt(disc)))
+            mod[1] = math.exp(h * (half - math.sqrt(disc)))
+        rho = _grouped(mod, 2, ref)
+    if s[11] > 0.0:
+        a = s[12] / s[11]
+        for _ in range(GENERATOR_SWEEPS):
+            a = (s[12] + a * a * s[13] / 12.0) / s[11]
+        rho = max(rho, math.exp(h * a))
+    return rho
+
+
+@njit(cache=True)
+def _generator_full(s, ng, ref, h):
+    """As :func:`_generator2` for the full sums of ``ng`` components, on the directions
+    the pairs span (whitened, as :func:`_map_radius`); NaN where they span none."""
+    n2 = ng * ng
+    P = np.empty((ng, ng))
+    Y = np.empty((ng, ng))
+    Z = np.empty((ng, ng))
+    for r in range(ng):
+        for c in range(ng):
+            P[r, c] = s[r * ng + c]
+            Y[r, c] = s[n2 + r * ng + c]
+            Z[r, c] = s[2 * n2 + r * ng + c]
+    w = np.zeros(ng)
+    for r in range(ng):
+        if P[r, r] > 0.0:
+            w[r] = 1.0 / math.sqrt(P[r, r])
+    for r in range(ng):
+        for c in range(ng):
+            P[r, c] *= w[r] * w[c]
+            Y[r, c] *= w[r] * w[c]
+            Z[r, c] *= w[r] * w[c]
+    lam, U = np.linalg.eigh(P)
+    top = lam[ng - 1]
+    if not (top > 0.0):
+        return math.nan
+    keep = 0
+    for i in range(ng):
+        if lam[i] >= MAP_RANK_TOL * top:
+            keep += 1
+    V = np.ascontiguousarray(U[:, ng - keep:])
+    Vt = np.ascontiguousarray(V.T)
+    Yr = Vt @ Y @ V
+    Zr = Vt @ Z @ V
+    Ar = Yr.copy()
+    for r in range(keep):
+        for c in range(keep):
+            Ar[r, c] = Yr[r, c] / lam[ng - keep + c]
+    for _ in range(GENERATOR_SWEEPS):
+        C = Yr + (Ar @ Ar) @ Zr / 12.0
+        for r in range(keep):
+            for c in range(keep):
+                Ar[r, c] = C[r, c] / lam[ng - keep + c]
+    for r in range(keep):
+        for c in range(keep):
+            if not math.isfinite(Ar[r, c]):
+                return math.nan
+    ev = np.linalg.eigvals(Ar.astype(np.complex128))
+    mod = np.empty(keep)
+    for i in range(keep):
+        mod[i] = math.exp(h * ev[i].real)
+    return _grouped(mod, keep, ref)
+
+
+@njit(cache=True)
+def _generator_radius(S, j, ng, pm, first, ref, h):
+    """``ρ`` equivalent of slot ``j``'s generator from bin ``first`` (:func:`_generator2`
+    or :func:`_generator_full`) and the number of pairs; NaN with too few pairs (a
+    parameter per unknown)."""
+    W = S.shape[2]
+    if first >= S.shape[1]:
+        return math.nan, 0.0
+    s = S[j, first]
+    pairs = s[W - 1]
+    if pm >= 0:
+        if pairs < 4.0:
+            return math.nan, pairs
+        rho = _generator2(s, ref, h)
+        return (rho if rho >= 0.0 else math.nan), pairs
+    if pairs < 2.0 * ng:
+        return math.nan, pairs
+    return _generator_full(s, ng, ref, h), pairs

@@ -121,25 +121,30 @@ class FixedMeasurement(NamedTuple):
 
 
 class AdaptiveMeasurement(NamedTuple):
-    """What the adaptive kernel measures: as :class:`FixedMeasurement`, on ``‖g‖∞`` at
-    every accepted step, with the prediction ``R = e^{Ã h_pred}``."""
+    """What the adaptive kernel measures: as :class:`FixedMeasurement`, at every accepted
+    step, on ``‖g − g_ref(t)‖∞``: ``g_ref`` the reference trajectory's accepted steps, a
+    row ``(t, g)`` each, linear in ``t`` between them (no rows: ``‖g‖∞``); with the
+    prediction ``R = e^{Ã h_pred}``."""
 
     divergence: float
     R: np.ndarray
     h_pred: float
     trace_row: np.ndarray
+    g_ref: np.ndarray
 
     @classmethod
-    def of(cls, divergence, R, h_pred, trace_row) -> AdaptiveMeasurement:
+    def of(cls, divergence, R, h_pred, trace_row, g_ref) -> AdaptiveMeasurement:
         return cls(float(divergence), np.ascontiguousarray(R, dtype=float), float(h_pred),
-                   np.ascontiguousarray(trace_row, dtype=np.int64))  # fmt: skip
+                   np.ascontiguousarray(trace_row, dtype=np.int64),
+                   np.ascontiguousarray(g_ref, dtype=float))  # fmt: skip
 
 
 class Outputs(NamedTuple):
     """Where the results go, one row per member (``norms``: per traced member and stored
     sample; ``meas``, ``codes``: the measurement record's float and integer columns,
     :mod:`stabdae.engine.decay.record`).  ``g_out``: the first member's residual at every
-    step (fixed steps; no rows: not kept); ``steps``, ``nfev``: accepted steps and
+    step (fixed steps; adaptive steps: ``(t, g)`` at its start and every accepted step, as
+    many as fit; no rows: not kept); ``steps``, ``nfev``: accepted steps and
     right-hand-side evaluations per member (adaptive steps; empty otherwise)."""
 
     norms: np.ndarray
@@ -156,15 +161,15 @@ class Outputs(NamedTuple):
 
 
 def outputs(members: int, n2: int, ng: int, ntraced: int, nsave: int, rdtype, *,
-            residuals: int = 0, counts: bool = False) -> Outputs:  # fmt: skip
+            residuals: int = 0, columns: int = 0, counts: bool = False) -> Outputs:  # fmt: skip
     """:class:`Outputs` for ``members`` members of state size ``n2``, allocated empty (the
     kernels write every element: the fixed-step kernel on its own threads, so that the
-    pages are first touched there); ``residuals`` rows of ``g_out``; ``counts``: the
-    adaptive kernel's step counts."""
+    pages are first touched there); ``residuals`` rows of ``g_out`` (of ``columns``
+    columns, ``ng`` by default); ``counts``: the adaptive kernel's step counts."""
     rec = Record.empty(members)
     per = members if counts else 0
     return Outputs(np.empty((ntraced, nsave), dtype=rdtype), rec.values, rec.codes,
                    np.empty((members, n2)), np.empty(members, dtype=np.int8),
                    np.empty(members, dtype=np.int64), np.empty(members), np.empty(members),
-                   np.full((residuals, ng), np.nan), np.zeros(per, dtype=np.int64),
+                   np.full((residuals, columns or ng), np.nan), np.zeros(per, dtype=np.int64),
                    np.zeros(per, dtype=np.int64))  # fmt: skip

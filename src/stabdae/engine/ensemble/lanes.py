@@ -14,10 +14,27 @@ import numpy as np
 from numba import njit
 
 from ..cache import Spec, keyed_cache, memo, tag
-from ..decay import begin, finish, ladders, observe, predict, scratch
+from ..decay import (
+    MAP_BINS,
+    MAP_SHIFT,
+    begin,
+    finish,
+    finish_with_map,
+    generator_add,
+    generator_store,
+    generator_width,
+    ladder_level,
+    ladders,
+    map_begin,
+    observe,
+    predict,
+    reference_logs,
+    scratch,
+)
 from ..rhs import kernels_for
 from ..rk.adaptive import _pattern, attempt_for
 from ..rk.control import _DIVERGED, _f_eval, _first_step, _next_step, _settle
+from .block import pooled_constraints
 
 
 # ------------------------------------------------------------------- samples
@@ -49,6 +66,45 @@ def _hermite(x0, f0, x1, f1, h, theta, out):
                                              + theta * h * f1[l]))  # fmt: skip
 
 
+@njit(cache=True)
+def _deviation(G, lane, g_ref, kp, t):
+    """Lane ``lane``'s residual ``G[:, lane]`` at time ``t`` made its distance from the
+    reference trajectory's, ``g − g_ref(t)``, linear in ``t`` between the rows ``(t, g)``
+    of ``g_ref`` around ``t`` (``kp[lane]``: the row at or before the lane's last time,
+    advanced here; the members' times only increase); returns ``‖g − g_ref(t)‖∞``
+    (``inf`` where it is not finite).
+
+    The reference trajectory's residual is its integrator's local errors, forced through
+    the law: a floor that moves with the motion and that a member's steps reproduce while
+    the motion sets them.  Linear between the reference's steps, it is a smooth function
+    of time read to well within its own size (a member near its floor and the reference
+    take nearly the same steps)."""
+    nr = g_ref.shape[0]
+    k = kp[lane]
+    while k + 2 < nr and g_ref[k + 1, 0] <= t:
+        k += 1
+    kp[lane] = k
+    w = 0.0
+    if k + 1 < nr and g_ref[k + 1, 0] > g_ref[k, 0]:
+        w = min(1.0, max(0.0, (t - g_ref[k, 0]) / (g_ref[k + 1, 0] - g_ref[k, 0])))
+    k1 = min(k + 1, nr - 1)
+    d = 0.0
+    for l in range(G.shape[0]):
+        a = g_ref[k, 1 + l]
+        G[l, lane] -= a + w * (g_ref[k1, 1 + l] - a)
+        d = max(d, abs(G[l, lane]))
+    return d if math.isfinite(d) else math.inf
+
+
+@njit(cache=True)
+def _record(g_out, row, t, G, lane):
+    """Row ``row`` of ``g_out`` (while it has one): ``(t, G[:, lane])``."""
+    if row < g_out.shape[0]:
+        g_out[row, 0] = t
+        for l in range(G.shape[0]):
+            g_out[row, 1 + l] = G[l, lane]
+
+
 # ------------------------------------------------------------------- lanes in lockstep
 #: members integrated side by side (lanes) in the block adaptive ensemble kernel
 LANES = 8
@@ -73,6 +129,7 @@ BUFFERS = {
     "HH": ("stack1(B)", "the attempted step (0: none yet)"),
     "E": ("stack1(B)", "the attempt's error norm"),
     "RN": ("stack1(B)", "the attempt's ‖g‖ at the new state"),
+    "GN": ("stack2(ng, B)", "... and g itself"),
     "GOOD": ("stack_int1(B)", "whether the attempt's right-hand sides succeeded"),
     "NEV": ("stack_int1(B)", "the attempt's evaluations"),
     "H": ("np.empty(B)", "the next step the control proposes"),
@@ -94,6 +151,12 @@ BUFFERS = {
     "k_o": ("np.empty(N2)", "... and its ẋ"),
     "lt, lv, base": ("ladders(B)", "each lane's ladder"),
     "rt, ry, fa, fb, lg": ("scratch()", "the fits' scratch"),
+    "G0": ("np.empty((B, ng))", "each lane's g − g_ref at its last accepted state"),
+    "kp": ("np.zeros(B, dtype=np.int64)", "each lane's row of the reference's steps"),
+    "Ag": ("np.zeros((B, GW))", "each lane's running sums of its generator's pairs"),
+    "S_g": ("np.zeros((B, MAP_BINS, GW))", "... per bin (as the one-step map's)"),
+    "low": ("np.zeros(B, dtype=np.int64)", "the lowest bin reached"),
+    "ref": ("reference_logs(R)", "the law's distinct ln |eigenvalue| of e^{h Ã}"),
     "g_p": ("np.empty(alpha0s.shape[1])", "the linear prediction's g"),
     "gn_p": ("np.empty(alpha0s.shape[1])", "... and its next g"),
     # inside the lane loop: per lane, on the stack
@@ -111,7 +174,8 @@ def adaptive_block_for(model, bound, pair, lanes: int = LANES):
     stage counts and norm, the number of lanes, the shape of the law's matrix)."""
     spec = Spec("lanes", law=bound.code, law_fn=bound.fn, pattern=_pattern(pair),
                 stages=(pair.scheme.stages, pair.error.shape[1]), combined=pair.combined,
-                block=lanes, n_params=len(model.param_names), law_shape=bound.matrix.shape)
+                block=lanes, n_params=len(model.param_names), law_shape=bound.matrix.shape,
+                pooled=pooled_constraints(model, bound.law))  # fmt: skip
     return memo(model, spec, lambda: _build_adaptive_block(kernels_for(model, bound), spec))
 
 
@@ -124,6 +188,8 @@ def _build_adaptive_block(K, spec: Spec):
     (s, s_e), combined, pattern, B = spec.stages, spec.combined, spec.pattern, spec.block
     NP = max(spec.n_params, 1)
     LR, LC = spec.law_shape
+    PM = spec.pooled
+    GW = generator_width(ng, PM)
     attempt = attempt_for(rhs, s, s_e, combined, pattern, N2, ng)
 
     f_eval = _f_eval(rhs)
@@ -140,7 +206,9 @@ def _build_adaptive_block(K, spec: Spec):
         x0, alpha0s, p, law_mat, law_scal = inputs
         t0, save_times, h0, rtol, atol, max_steps = grid
         tab_a, tab_b, tab_e, tab_c, q = tableau
-        divergence, R, h_pred, trace_row = measure
+        divergence, R, h_pred, trace_row, g_ref = measure
+        NR = g_ref.shape[0]
+        rec = out.g_out.shape[0] > 0  # the first member's (t, g) at every accepted step
         norms, meas, mcodes, x_final = out.norms, out.meas, out.codes, out.x_final
         status, fail_step, e0, e1 = out.status, out.fail_step, out.e0, out.e1
         steps, nfev = out.steps, out.nfev
@@ -172,6 +240,7 @@ def _build_adaptive_block(K, spec: Spec):
         HH = stack1(B)
         E = stack1(B)
         RN = stack1(B)
+        GN = stack2(ng, B)
         GOOD = stack_int1(B)
         NEV = stack_int1(B)
         H = np.empty(B)
@@ -192,6 +261,12 @@ def _build_adaptive_block(K, spec: Spec):
         k_o = np.empty(N2)
         lt, lv, base = ladders(B)
         rt, ry, fa, fb, lg = scratch()
+        G0 = np.empty((B, ng))
+        kp = np.zeros(B, dtype=np.int64)
+        Ag = np.zeros((B, GW))
+        S_g = np.zeros((B, MAP_BINS, GW))
+        low = np.zeros(B, dtype=np.int64)
+        ref = reference_logs(R)
         g_p = np.empty(alpha0s.shape[1])
         gn_p = np.empty(alpha0s.shape[1])
         nxt = lo
@@ -226,8 +301,16 @@ def _build_adaptive_block(K, spec: Spec):
                             X[l, lane] = XN[l, lane]
                             K0[l, lane] = KL[l, lane]
                         window = min(4, int(5.0 * (t - t0) / span))
-                        observe(lt, lv, base, meas, lane, i, t - t0, RN[lane], RN[lane],
-                                window)  # fmt: skip
+                        if rec and i == lo:
+                            _record(out.g_out, acc_n[lane], t, GN, lane)
+                        d = _deviation(GN, lane, g_ref, kp, t) if NR > 0 else RN[lane]
+                        observe(lt, lv, base, meas, lane, i, t - t0, RN[lane], d, window)
+                        if d < math.inf:  # the generator's pair, binned by when
+                            generator_add(Ag, lane, G0, GN, hh, PM)
+                            nb = ladder_level(d, base[lane]) >> MAP_SHIFT
+                            if nb < low[lane]:
+                                generator_store(S_g, Ag, lane, nb + 1, low[lane])
+                                low[lane] = nb
                         if inside:  # ... its end
                             for l in range(N2):
                                 x_h[l] = X[l, lane]
@@ -278,8 +361,10 @@ def _build_adaptive_block(K, spec: Spec):
                         final = 0.0
                         for l in range(ng):
                             final = max(final, abs(g_h[l]))
-                    finish(lt, lv, meas, mcodes, lane, i, final, st != 0,
-                           span / max(acc_n[lane], 1), rt, ry, fa, fb, lg)  # fmt: skip
+                    generator_store(S_g, Ag, lane, 0, low[lane])
+                    finish_with_map(lt, lv, S_g, meas, mcodes, lane, i, final, st != 0, ng, PM,
+                                    base[lane], 0, span / max(acc_n[lane], 1), rt, ry, fa,
+                                    fb, lg, ref, h_pred)  # fmt: skip
                     if R.shape[0] > 0:
                         predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt, lv,
                                 base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
@@ -306,7 +391,20 @@ def _build_adaptive_block(K, spec: Spec):
                     r0 = 0.0
                     for l in range(ng):
                         r0 = max(r0, abs(g_h[l]))
-                    begin(lt, lv, base, meas, mcodes, lane, i, r0, r0)
+                    d0 = 0.0
+                    kp[lane] = 0
+                    for l in range(ng):
+                        if rec and i == lo:
+                            out.g_out[0, 1 + l] = g_h[l]
+                        G0[lane, l] = g_h[l] - (g_ref[0, 1 + l] if NR > 0 else 0.0)
+                        d0 = max(d0, abs(G0[lane, l]))
+                    if rec and i == lo:
+                        out.g_out[0, 0] = t0
+                    begin(lt, lv, base, meas, mcodes, lane, i, r0, d0)
+                    map_begin(S_g, lane)
+                    for c in range(GW):
+                        Ag[lane, c] = 0.0
+                    low[lane] = ladder_level(d0, base[lane]) >> MAP_SHIFT
                     acc_n[lane] = rej_n[lane] = fev_n[lane] = 0
                     # sample 0 (as the single loop's save: ‖g‖ at t0, checked)
                     r = r0 if math.isfinite(r0) else math.inf
@@ -379,6 +477,8 @@ def _build_adaptive_block(K, spec: Spec):
                 NEV[lane] = nev
                 E[lane] = e
                 RN[lane] = r
+                for l in range(ng):
+                    GN[l, lane] = ws.g[l]
 
     key = spec.key(K.key)
     tag(key, attempt, f_eval, first_step)
