@@ -454,3 +454,32 @@ def test_search_validation(tmp_path, edit, message):
     path = write(tmp_path, SEARCH.replace(*edit))
     with pytest.raises(StudyError, match=r"^study.toml: " + message):
         load_study(path)
+
+
+def test_summary_names_unstable_members_where_the_law_is_stable():
+    """The run's summary has an ``unstable`` column, and below the table a line for each
+    grid point whose law is stable in the linear theory (ρ(R) < 1) but has unstable
+    members, with their count and reasons; none for a point with ρ ≥ 1 or no unstable
+    member."""
+    from stabdae._codes import Verdict, VerdictReason
+    from stabdae.study.report import summary
+
+    S, U = int(Verdict.STABLE), int(Verdict.UNSTABLE)
+    verdict = np.array([[S, S, S, S], [U, U, U, S], [U, U, U, U]], dtype=np.int8)
+    reason = np.array([[0, 0, 0, 0], [int(VerdictReason.BLEW_UP), int(VerdictReason.BLEW_UP),
+                        int(VerdictReason.BEYOND_BOUND), 0], [int(VerdictReason.GREW)] * 4],
+                      dtype=np.int8)  # fmt: skip
+    ds = xr.Dataset({"verdict": (("run.tau", "member"), verdict),
+                     "verdict_reason": (("run.tau", "member"), reason),
+                     "spectral_radius": ("run.tau", [0.5, 0.8, 1.2]),
+                     "fraction_stable": ("run.tau", (verdict == S).mean(axis=1)),
+                     "fraction_unstable": ("run.tau", (verdict == U).mean(axis=1))},
+                    coords={"run.tau": [0.01, 0.02, 0.04]})  # fmt: skip
+    text = summary(ds)
+    assert "unstable" in text.splitlines()[2]
+    notes = text.split("unstable where the law's linear part is stable")[1].splitlines()[1:]
+    assert [n for n in notes if n.strip()] == [
+        "  tau = 0.02: rho(R) = 0.8 < 1, yet 3 of 4 members unstable (2 blew up; 1 grew "
+        "beyond the law's bound)"]
+    calm = ds.isel({"run.tau": [0, 2]})
+    assert "linear part is stable" not in summary(calm)

@@ -3,7 +3,10 @@ measurements beside them (``stabdae run``), one row per grid point."""
 
 from __future__ import annotations
 
+import numpy as np
 import xarray as xr
+
+from .._codes import Verdict, VerdictReason
 
 __all__ = ["format_table", "grid_table", "summary"]
 
@@ -64,20 +67,55 @@ def summary(ds: xr.Dataset) -> str:
                 "ensemble) and high; tau_floor: Theorems 6/7 with the floor the local error "
                 "forces; tau_spectral: rho(R) = 1):")  # fmt: skip
         return "\n" + head + "\n" + grid_table(ds, cols, short, precise=cols[:5]) + "\n"
-    cols = [c for c in ("fraction_stable", "fraction_undecided", "fraction_bounded",
+    cols = [c for c in ("fraction_stable", "fraction_unstable", "fraction_undecided",
+                        "fraction_bounded",
                         "stability_radius",
                         "beta_median", "members_with_beta", "beta_ratio_median",
                         "beta_theory_discrete", "spectral_radius", "norm_condition",
                         "beta_theorem5_proven", "beta_theorem5_printed") if c in ds]  # fmt: skip
-    short = {"fraction_stable": "stable", "fraction_undecided": "undecided",
+    short = {"fraction_stable": "stable", "fraction_unstable": "unstable",
+             "fraction_undecided": "undecided",
              "fraction_bounded": "bounded",
              "stability_radius": "delta*", "beta_median": "beta_med",
              "members_with_beta": "n_beta", "beta_ratio_median": "meas/lin",
              "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
              "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
              "beta_theorem5_printed": "b5_printed"}  # fmt: skip
-    head = ("summary (stable, undecided, bounded: fractions of members (undecided: the run "
+    head = ("summary (stable, unstable, undecided, bounded: fractions of members "
+            "(undecided: the run "
             "cannot tell, see verdict_reason); delta*: stability radius; "
             "n_beta: members with a measured beta; meas/lin: median of measured over the "
             "linear prediction's beta; beta_pred = -ln rho(R)/tau):")  # fmt: skip
-    return "\n" + head + "\n" + grid_table(ds, cols, short, flags=("norm_condition",)) + "\n"
+    table = grid_table(ds, cols, short, flags=("norm_condition",))
+    return "\n" + head + "\n" + table + "\n" + unstable_below_one(ds)
+
+
+def unstable_below_one(ds: xr.Dataset) -> str:
+    """A note per grid point whose law is stable in the linear theory (``ρ(R) < 1``) but
+    whose members are not all stable: how many are unstable, and why (the counts of
+    their ``verdict_reason``); empty where there is none."""
+    if not {"spectral_radius", "verdict", "verdict_reason"} <= set(ds.variables):
+        return ""
+    dims = list(ds.spectral_radius.dims)
+    flat = ds[["spectral_radius", "verdict", "verdict_reason"]]
+    flat = flat.stack(point=dims) if dims else flat.expand_dims(point=[0])
+    lines = []
+    for i in range(flat.sizes["point"]):
+        rho = float(flat.spectral_radius.values[i])
+        verdict = flat.verdict.isel(point=i).values
+        unstable = verdict == int(Verdict.UNSTABLE)
+        if not (rho < 1.0) or not unstable.any():
+            continue
+        where = ", ".join(f"{d.split('.', 1)[-1]} = {float(flat[d].values[i]):.4g}"
+                          for d in dims)  # fmt: skip
+        reasons, counts = np.unique(flat.verdict_reason.isel(point=i).values[unstable],
+                                    return_counts=True)  # fmt: skip
+        why = "; ".join(f"{c} {VerdictReason(int(r)).message.split(':')[0]}"
+                        for r, c in zip(reasons, counts))  # fmt: skip
+        lines.append(f"  {where}: rho(R) = {rho:.4g} < 1, yet {int(unstable.sum())} of "
+                     f"{verdict.size} members unstable ({why})")
+    if not lines:
+        return ""
+    return ("\nunstable where the law's linear part is stable (rho(R) < 1: what grows there "
+            "is the rest of the step, the scheme's remainder on the motion that Theorems 6/7 "
+            "bound, not the law):\n" + "\n".join(lines) + "\n")
