@@ -178,6 +178,10 @@ class VerdictReason(_Codes):
     DECAYED_RHO_ABOVE_ONE = 9, ("decayed over this run, though rho >= 1: a growing mode may "
                                 "not have been excited above the floor yet")
     NOT_RUN = 10, "not run: not placed, or out of steps"
+    ROSE_BELOW_START = 11, ("rose again below its start (rho < 1): the deviation left the "
+                            "law's bound and rose over the last three fifths, but stayed "
+                            "below where it started: the floor of a motion that has left "
+                            "the reference's, which this run cannot tell from slow growth")
 
 
 class TauStarReason(_Codes):

@@ -146,7 +146,10 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
     With the theory and ``ρ < 1``: *stable* where the deviation over the last fifth lies
     within ``TRANSIENT_SLACK`` times the law's bound plus the floor band; *unstable* only
     where it blew up past what the bound allows, or rose over the last three fifths
-    (:func:`stabdae.engine.decay.grows`) beyond the bound; otherwise *undecided*.  With
+    (:func:`stabdae.engine.decay.grows`) beyond the bound and past its own start (a rise
+    that stays below the start is the floor of a motion that has left the reference's:
+    a member knocked far, a four-bar set spinning, carries a floor of its own);
+    otherwise *undecided*.  With
     ``ρ ≥ 1``: *unstable* where it blew up or grew; a member that decayed is undecided
     (the growing mode may lie under the floor).  Without the theory: *unstable* where it
     blew up, or grew above the floor band and its start; *stable* where it ended below
@@ -176,7 +179,10 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
 
     if theory_known and rho < 1.0:
         put(~within & ~grew, V_UNDECIDED, R_.ABOVE_BOUND)
-        put(~within & grew, V_UNSTABLE, R_.BEYOND_BOUND)
+        with np.errstate(invalid="ignore"):
+            past_start = d4 > d0
+        put(~within & grew & past_start, V_UNSTABLE, R_.BEYOND_BOUND)
+        put(~within & grew & ~past_start, V_UNDECIDED, R_.ROSE_BELOW_START)
         put(within & ~ended_low, V_STABLE, R_.WITHIN_BOUND)
         put(within & ended_low, V_STABLE, R_.DECAYED)
     elif theory_known:

@@ -49,6 +49,15 @@ def test_verdict_rule_with_the_theory():
     assert v.tolist() == [V_STABLE, V_STABLE, V_UNSTABLE, V_UNDECIDED, V_STABLE]
     assert r.tolist() == [R_.DECAYED, R_.WITHIN_BOUND, R_.BEYOND_BOUND, R_.ABOVE_BOUND,
                           R_.WITHIN_BOUND]  # fmt: skip
+    # the law's transient over by the last fifth (bound 1e-12): a deviation that left the
+    # bound and grew, past its start (unstable) or staying 25× below it (undecided: the
+    # floor of a motion that has left the reference's)
+    late = np.array([1.0, 3.0, 3.0, 2.0, 1e-12])
+    v, r = verdict(_record(np.array([1e-3, 1e-1]), np.array([1e-3, 1e-3]),
+                           np.array([2e-3, 2e-3]), np.array([4e-3, 4e-3])),
+                   np.zeros(2, dtype=np.int8), band, late, rho=0.9)  # fmt: skip
+    assert v.tolist() == [V_UNSTABLE, V_UNDECIDED]
+    assert r.tolist() == [R_.BEYOND_BOUND, R_.ROSE_BELOW_START]
     # stopped by the divergence threshold: inside the bound (2·3·1e-3 + 1e-5 ≥ 5e-3) no
     # evidence; past it, blown up; a non-finite state is always unstable; not placed: not run
     status = np.array([4, 4, 3, 5, 0], dtype=np.int8)

@@ -16,8 +16,9 @@ library shows.
    noise): undecided, ``stopped in transient``;
 3. with the theory and ``ρ < 1``, ``allowed = 2 · bound_4 · d0 + noise_4``:
    within it (``d4 ≤ allowed``) stable, ``decayed`` if ``d4 < d0`` else ``within bound``;
-   beyond it, ``beyond bound`` (unstable) if it grew (resolved, growth, ``d4 > noise_4``),
-   else ``above bound`` (undecided);
+   beyond it, ``beyond bound`` (unstable) if it grew (resolved, growth, ``d4 > noise_4``)
+   past its start (``d4 > d0``), ``rose below start`` (undecided) if it grew but not past
+   its start, else ``above bound`` (undecided);
 4. with the theory and ``ρ ≥ 1``: grew (resolved, growth, ``d4 > d0`` or ``d4 >
    noise_4``): unstable, ``grew``; ended below its start: undecided, ``decayed though ρ
    ≥ 1``; else undecided, ``too short``;
@@ -78,7 +79,8 @@ def verdict(d0, d2, d3, d4, status, floor_band=None, bounds=None, rho=math.nan,
         if d4 <= TRANSIENT_SLACK * bounds[4] * d0 + noise[4]:
             return V.STABLE, (R.DECAYED if d4 < d0 else R.WITHIN_BOUND)
         if rising and d4 > noise[4]:
-            return V.UNSTABLE, R.BEYOND_BOUND
+            return (V.UNSTABLE, R.BEYOND_BOUND) if d4 > d0 else (V.UNDECIDED,
+                                                                 R.ROSE_BELOW_START)
         return V.UNDECIDED, R.ABOVE_BOUND
     if theory:
         if rising and (d4 > d0 or d4 > noise[4]):
