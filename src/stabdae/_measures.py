@@ -148,7 +148,7 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
     where it blew up past what the bound allows, or rose over the last three fifths
     (:func:`stabdae.engine.decay.grows`) beyond the bound and past its own start (a rise
     that stays below the start is the floor of a motion that has left the reference's:
-    a member knocked far, a four-bar set spinning, carries a floor of its own);
+    a member knocked into a faster motion carries a floor of its own);
     otherwise *undecided*.  With
     ``ρ ≥ 1``: *unstable* where it blew up or grew; a member that decayed is undecided
     (the growing mode may lie under the floor).  Without the theory: *unstable* where it

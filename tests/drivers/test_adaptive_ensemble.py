@@ -159,21 +159,27 @@ def test_adaptive_samples_change_no_step():
         np.testing.assert_allclose(got[far], ref[far], rtol=5e-3)
 
 
-@pytest.mark.parametrize("pair, xi", [("dopri5", 0.5), ("dopri5", 1.0), ("dop853", 1.0),
-                                      ("dop853", 2.0)])  # fmt: skip
-def test_adaptive_member_rates_down_to_their_floor(pair, xi):
+@pytest.mark.parametrize("pair, xi, rtol, share", [("dopri5", 0.5, 1e-8, 0.99),
+                                                   ("dopri5", 1.0, 1e-8, 0.99),
+                                                   ("dop853", 1.0, 1e-8, 0.99),
+                                                   ("dop853", 2.0, 1e-8, 0.99),
+                                                   ("dopri5", 1.0, 1e-6, 0.95)])  # fmt: skip
+def test_adaptive_member_rates_down_to_their_floor(pair, xi, rtol, share):
     """Each member's β from the generator fitted to its accepted steps, on its distance
     from the reference trajectory's residual, against the law's rate: at rtol = 1e-8,
     99 % of the members 10× above their floor (α⁰ from 1e-8 to 1e-1) within 1 %, and
     every β given within 1 % (read from the raw residual's envelope, 39 % were, and the
-    fits were off by up to 18 %)."""
+    fits were off by up to 18 %).  At rtol = 1e-6 a few members have fewer than a dozen
+    steps above their floor: they get no β rather than one from a handful of pairs (one
+    of 8 pairs was 1.75 % off), and a member that starts below the reference's floor
+    gets none (one read half the rate)."""
     ds = stabdae.ensemble(load_scene("pendulum"), stabdae.baumgarte(10.0, xi), pair, 1e-3,
-                          5.0, rtol=1e-8, members=256, seed=1, radius=(1e-8, 1e-1),
+                          5.0, rtol=rtol, members=256, seed=1, radius=(1e-8, 1e-1),
                           traces="none", states=False)  # fmt: skip
     ratio = ds.beta_ratio.values.astype(float)
     above = ds.alpha0_norm.values >= 10.0 * ds.residual_floor.values
-    assert above.sum() >= 180, above.sum()
-    assert np.mean(np.abs(ratio[above] - 1.0) <= 0.01) >= 0.99
+    assert above.sum() >= 120, above.sum()
+    assert np.mean(np.abs(ratio[above] - 1.0) <= 0.01) >= share
     given = np.isfinite(ratio)
     np.testing.assert_allclose(ratio[given], 1.0, atol=0.01)
     assert (ds.beta_predicted.values[given] == float(ds.beta_theory)).all()

@@ -373,9 +373,9 @@ def test_member_rates_on_models_the_project_does_not_ship(name, scheme, xi):
     ω = 10 over 5 s, rtol = 1e-8), 256 members from 1e-8 to 1e-1: none unstable, 99 %
     stable, and 98 % of those 10× above their floor with β within 1 % of their linear
     prediction.  (Under Euler the four-bar member knocked hardest, ‖α⁰‖ = 0.084, leaves
-    the linear regime: its β is 1.1 % low, and it spins, its own floor rising below its
-    start: undecided.  ``studies/check_member_rates.py``'s count with another seed: all
-    36 pairs of scheme and damping ratio 100 %.)"""
+    the linear regime: its β is 1.1 % low, and, thrown into a motion five times as fast,
+    its own floor rises below its start: undecided.  ``studies/check_member_rates.py``'s
+    count with another seed: all 36 pairs of scheme and damping ratio 100 %.)"""
     import importlib
 
     model = importlib.import_module(f"models.{name}").model

@@ -62,8 +62,9 @@ _GENERATOR = tuple(
 
 #: adaptive members' rates down to their floor
 _ADAPTIVE_RATES = (
-    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_member_rates_down_to_their_floor[dopri5-1.0]',
-    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_member_rates_down_to_their_floor[dop853-2.0]',
+    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_member_rates_down_to_their_floor[dopri5-1.0-1e-08-0.99]',
+    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_member_rates_down_to_their_floor[dop853-2.0-1e-08-0.99]',
+    'tests/drivers/test_adaptive_ensemble.py::test_adaptive_member_rates_down_to_their_floor[dopri5-1.0-1e-06-0.95]',
     'tests/drivers/test_adaptive_ensemble.py::test_adaptive_samples_change_no_step',
 )
 
@@ -680,6 +681,13 @@ MUTANTS = [
            "            if pairs < 2:",
            _ADAPTIVE_RATES,
            "the generator takes a window of a handful of pairs"),
+    Mutant("adaptive-floor-from-last-fifth",
+           E + "decay/onestep.py",
+           "    floor = max(out[C_D4], floor_min)",
+           "    floor = out[C_D4]",
+           _ADAPTIVE_RATES,
+           "the generator's window is cut above its last fifth's floor only, not the "
+           "reference's"),
     # ---- a reviewer's changes that passed the suite (each now caught by a test that says
     #      what it checks)
     Mutant("growth-middle-dropped",

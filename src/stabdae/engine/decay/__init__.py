@@ -105,6 +105,7 @@ from .member import (  # noqa: F401
 )
 from .onestep import (  # noqa: F401
     CLUSTER,
+    GENERATOR_MARGIN,
     GENERATOR_SWEEPS,
     MAP_BINS,
     MAP_MARGIN,

@@ -35,6 +35,7 @@ from .record import (
     NCODES,
     NCOLS,
     R_FITTED,
+    R_NO_TRANSIENT,
     R_NOT_DECAYING,
     R_STOPPED,
 )
@@ -90,12 +91,13 @@ def finish(lt, lv, meas, codes, j, row, final, stopped, dt, rt, ry, a, b, lg):
 
 @njit(cache=True)
 def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base_j, lowest, dt, rt,
-                    ry, a, b, lg, ref, gen_h=0.0):  # fmt: skip
+                    ry, a, b, lg, ref, gen_h=0.0, floor_min=0.0, envelope=True):  # fmt: skip
     """:func:`finish` for a member with one-step map sums ``S`` (:func:`map_estimate`,
     ``dt`` the time between the map's pairs; ``lowest`` a level below which ladder row
     ``j`` has no point; ``ref`` the law's spectrum, :func:`reference_logs`; ``gen_h > 0``:
-    ``S`` holds a generator's sums, :func:`map_estimate`): β from the map where it has
-    one, else from the envelope.  A member whose largest norms grow
+    ``S`` holds a generator's sums, and ``floor_min`` the least floor, :func:`map_estimate`):
+    β from the map where it has one, else from the envelope (unless not ``envelope``:
+    then none, with the reason ``no transient``).  A member whose largest norms grow
     (:func:`grows`) gets the map only when the envelope does not find it growing (it may
     decay first, which the map would read), so its envelope is fitted first; unless the
     last fifth's largest norm lies a decade (``MIN_DECADES``) or more below the start:
@@ -112,10 +114,15 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
         fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                         lowest, gen_h)  # fmt: skip
+                         lowest, gen_h, floor_min)  # fmt: skip
     elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                          lowest, gen_h):  # fmt: skip
-        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
+                          lowest, gen_h, floor_min):  # fmt: skip
+        if envelope:
+            fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
+        else:
+            codes[row, I_POINTS] = 0
+            codes[row, I_KIND] = K_NONE
+            codes[row, I_REASON] = R_NO_TRANSIENT
 
 
 @njit(cache=True)

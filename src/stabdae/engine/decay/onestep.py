@@ -646,7 +646,7 @@ def _map_gamma(lt, lv, j, lo, top, beta, u):
 
 @njit(cache=True)
 def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref,
-                 lowest=0, gen_h=0.0):  # fmt: skip
+                 lowest=0, gen_h=0.0, floor_min=0.0):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
@@ -663,12 +663,14 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
     (:func:`fit_envelope`).
     ``lowest``: no level below it was visited (γ's pass starts there).  ``gen_h > 0``:
     ``S`` holds the sums of the generator (adaptive steps, :func:`generator_add`), read
-    on the scale of a step ``gen_h`` (``ref``'s); ``β = −max Re λ(Â)``.  Returns whether
-    it gave β."""
+    on the scale of a step ``gen_h`` (``ref``'s); ``β = −max Re λ(Â)``.  ``floor_min``:
+    the least floor the cut is taken from (an adaptive member's distance from the
+    reference has a floor of its own, the local errors of steps that fall apart from the
+    reference's, which its last fifth may not show).  Returns whether it gave β."""
     out = meas[row]
     if S.shape[2] == 0:
         return False
-    floor = out[C_D4]
+    floor = max(out[C_D4], floor_min)
     still = (out[C_D2] > out[C_D3] > out[C_D4]
              and out[C_D2] >= MAP_STILL_DECAYING * out[C_D4])  # fmt: skip
     top = -1
@@ -739,6 +741,10 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
 #: trapezoidal fit's ``(hβ)²/12`` by about another ``(hβ)²/12``; the third is past
 #: roundoff for ``hβ < 0.5``)
 GENERATOR_SWEEPS = 3
+#: the generator's window may reach down to this many times its floor (after
+#: ``MAP_MARGIN`` and ``FLOOR_MARGIN``): what is left there is the noise of a member's
+#: steps falling apart from the reference's, which the least-squares fit averages, not a
+#: bias
 GENERATOR_MARGIN = 10.0
 
 

@@ -15,6 +15,7 @@ from numba import njit
 
 from ..cache import Spec, keyed_cache, memo, tag
 from ..decay import (
+    GENERATOR_MARGIN,
     MAP_BINS,
     MAP_SHIFT,
     begin,
@@ -208,6 +209,15 @@ def _build_adaptive_block(K, spec: Spec):
         tab_a, tab_b, tab_e, tab_c, q = tableau
         divergence, R, h_pred, trace_row, g_ref = measure
         NR = g_ref.shape[0]
+        # the least floor of the distance from the reference, whose steps' local errors
+        # differ from a member's by a share of their own size that a member's last fifth
+        # need not show: a hundredth of the reference's largest residual (the generator's
+        # last margin then cuts at a tenth of it).  With the last fifth alone, a member
+        # that started below the reference's floor read half the rate (dopri5, rtol 1e-6)
+        floor_min = 0.0
+        for k in range(NR):
+            for l in range(1, g_ref.shape[1]):
+                floor_min = max(floor_min, abs(g_ref[k, l]) / (10.0 * GENERATOR_MARGIN))
         rec = out.g_out.shape[0] > 0  # the first member's (t, g) at every accepted step
         norms, meas, mcodes, x_final = out.norms, out.meas, out.codes, out.x_final
         status, fail_step, e0, e1 = out.status, out.fail_step, out.e0, out.e1
@@ -364,7 +374,7 @@ def _build_adaptive_block(K, spec: Spec):
                     generator_store(S_g, Ag, lane, 0, low[lane])
                     finish_with_map(lt, lv, S_g, meas, mcodes, lane, i, final, st != 0, ng, PM,
                                     base[lane], 0, span / max(acc_n[lane], 1), rt, ry, fa,
-                                    fb, lg, ref, h_pred)  # fmt: skip
+                                    fb, lg, ref, h_pred, floor_min, NR == 0)  # fmt: skip
                     if R.shape[0] > 0:
                         predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt, lv,
                                 base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
