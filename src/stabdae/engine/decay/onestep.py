@@ -763,45 +763,49 @@ def generator_width(ng, pm):
 def generator_add(A, j, G0, G1, h, pm):
     """The pair of slot ``j``'s residuals ``G0[j]`` (the accepted state before) and
     ``G1[:, j]`` (the new one), a step ``h`` apart, added to its running sums ``A[j]``
-    (:func:`generator_width`); then ``G0[j] = G1[:, j]``."""
+    (:func:`generator_width`); then ``G0[j] = G1[:, j]``.  (Once per accepted step of
+    every member: one division, no array view.)"""
     ng = G0.shape[1]
-    a = A[j]
-    if a.shape[0] == 0:
+    W = A.shape[1]
+    if W == 0:
         return
+    ih = 1.0 / h
     if pm >= 0:
         for i in range(pm):
             p0 = 0.5 * (G0[j, i] + G1[i, j])
             p1 = 0.5 * (G0[j, pm + i] + G1[pm + i, j])
             d0 = G1[i, j] - G0[j, i]
             d1 = G1[pm + i, j] - G0[j, pm + i]
-            a[0] += p0 * p0
-            a[1] += p0 * p1
-            a[2] += p1 * p1
-            a[3] += d0 / h * p0
-            a[4] += d0 / h * p1
-            a[5] += d1 / h * p0
-            a[6] += d1 / h * p1
-            a[7] += h * d0 * p0
-            a[8] += h * d0 * p1
-            a[9] += h * d1 * p0
-            a[10] += h * d1 * p1
+            y0, y1, z0, z1 = d0 * ih, d1 * ih, h * d0, h * d1
+            A[j, 0] += p0 * p0
+            A[j, 1] += p0 * p1
+            A[j, 2] += p1 * p1
+            A[j, 3] += y0 * p0
+            A[j, 4] += y0 * p1
+            A[j, 5] += y1 * p0
+            A[j, 6] += y1 * p1
+            A[j, 7] += z0 * p0
+            A[j, 8] += z0 * p1
+            A[j, 9] += z1 * p0
+            A[j, 10] += z1 * p1
         for i in range(2 * pm, ng):
             p = 0.5 * (G0[j, i] + G1[i, j])
             d = G1[i, j] - G0[j, i]
-            a[11] += p * p
-            a[12] += d / h * p
-            a[13] += h * d * p
+            A[j, 11] += p * p
+            A[j, 12] += d * ih * p
+            A[j, 13] += h * d * p
     else:
         n2 = ng * ng
         for r in range(ng):
             pr = 0.5 * (G0[j, r] + G1[r, j])
             dr = G1[r, j] - G0[j, r]
+            yr, zr = dr * ih, h * dr
             for c in range(ng):
                 pc = 0.5 * (G0[j, c] + G1[c, j])
-                a[r * ng + c] += pr * pc
-                a[n2 + r * ng + c] += dr / h * pc
-                a[2 * n2 + r * ng + c] += h * dr * pc
-    a[a.shape[0] - 1] += 1.0
+                A[j, r * ng + c] += pr * pc
+                A[j, n2 + r * ng + c] += yr * pc
+                A[j, 2 * n2 + r * ng + c] += zr * pc
+    A[j, W - 1] += 1.0
     for l in range(ng):
         G0[j, l] = G1[l, j]
 

@@ -26,7 +26,6 @@ from ..decay import (
     generator_width,
     ladder_level,
     ladders,
-    map_begin,
     observe,
     predict,
     reference_logs,
@@ -154,6 +153,7 @@ BUFFERS = {
     "rt, ry, fa, fb, lg": ("scratch()", "the fits' scratch"),
     "G0": ("np.empty((B, ng))", "each lane's g − g_ref at its last accepted state"),
     "kp": ("np.zeros(B, dtype=np.int64)", "each lane's row of the reference's steps"),
+    "dp": ("np.zeros(B)", "each lane's distance at its last accepted state"),
     "Ag": ("np.zeros((B, GW))", "each lane's running sums of its generator's pairs"),
     "S_g": ("np.zeros((B, MAP_BINS, GW))", "... per bin (as the one-step map's)"),
     "low": ("np.zeros(B, dtype=np.int64)", "the lowest bin reached"),
@@ -218,6 +218,10 @@ def _build_adaptive_block(K, spec: Spec):
         for k in range(NR):
             for l in range(1, g_ref.shape[1]):
                 floor_min = max(floor_min, abs(g_ref[k, l]) / (10.0 * GENERATOR_MARGIN))
+        # no window is cut below this (the generator's last margin over floor_min): a
+        # pair wholly below it is never read (its bins are filled before it, and a run
+        # that ended still decaying fits the pairs above it), and is not summed
+        cut_min = GENERATOR_MARGIN * floor_min
         rec = out.g_out.shape[0] > 0  # the first member's (t, g) at every accepted step
         norms, meas, mcodes, x_final = out.norms, out.meas, out.codes, out.x_final
         status, fail_step, e0, e1 = out.status, out.fail_step, out.e0, out.e1
@@ -273,6 +277,7 @@ def _build_adaptive_block(K, spec: Spec):
         rt, ry, fa, fb, lg = scratch()
         G0 = np.empty((B, ng))
         kp = np.zeros(B, dtype=np.int64)
+        dp = np.zeros(B)
         Ag = np.zeros((B, GW))
         S_g = np.zeros((B, MAP_BINS, GW))
         low = np.zeros(B, dtype=np.int64)
@@ -316,7 +321,12 @@ def _build_adaptive_block(K, spec: Spec):
                         d = _deviation(GN, lane, g_ref, kp, t) if NR > 0 else RN[lane]
                         observe(lt, lv, base, meas, lane, i, t - t0, RN[lane], d, window)
                         if d < math.inf:  # the generator's pair, binned by when
-                            generator_add(Ag, lane, G0, GN, hh, PM)
+                            if d >= cut_min or dp[lane] >= cut_min:
+                                generator_add(Ag, lane, G0, GN, hh, PM)
+                            else:  # below every window: the state carried, no sums
+                                for l in range(ng):
+                                    G0[lane, l] = GN[l, lane]
+                            dp[lane] = d
                             nb = ladder_level(d, base[lane]) >> MAP_SHIFT
                             if nb < low[lane]:
                                 generator_store(S_g, Ag, lane, nb + 1, low[lane])
@@ -411,10 +421,16 @@ def _build_adaptive_block(K, spec: Spec):
                     if rec and i == lo:
                         out.g_out[0, 0] = t0
                     begin(lt, lv, base, meas, mcodes, lane, i, r0, d0)
-                    map_begin(S_g, lane)
+                    dp[lane] = d0
                     for c in range(GW):
                         Ag[lane, c] = 0.0
                     low[lane] = ladder_level(d0, base[lane]) >> MAP_SHIFT
+                    # the bins at and below the start are all written before they are
+                    # read (as the level falls past them, or at the end); those above it
+                    # never are: cleared
+                    for b_ in range(low[lane] + 1, MAP_BINS):
+                        for c in range(GW):
+                            S_g[lane, b_, c] = 0.0
                     acc_n[lane] = rej_n[lane] = fev_n[lane] = 0
                     # sample 0 (as the single loop's save: ‖g‖ at t0, checked)
                     r = r0 if math.isfinite(r0) else math.inf
