@@ -542,6 +542,39 @@ def _pooled_radius(S, j, first, ref):
 
 
 @njit(cache=True)
+def _spanned(S0, S1, S2):
+    """``S0 = Σ p pᵀ`` whitened (each component scaled to unit sum of squares), with
+    ``S1`` and ``S2`` (sums over the same pairs, ``Σ u pᵀ``; ``S2`` may be ``S1``, scaled
+    once) alike, in place; and the directions the pairs span: the eigenvalues of the
+    whitened ``S0`` at least ``MAP_RANK_TOL`` of its largest, with their eigenvectors
+    (none where it is zero).
+
+    Baumgarte's law acts alike on every constraint, so the residual of m constraints moves
+    in a plane of its 2m dimensions, and a fit over all of them gives the remaining
+    directions the floor's dynamics."""
+    ng = S0.shape[0]
+    w = np.zeros(ng)
+    for r in range(ng):
+        if S0[r, r] > 0.0:
+            w[r] = 1.0 / math.sqrt(S0[r, r])
+    for r in range(ng):
+        for q in range(ng):
+            S0[r, q] *= w[r] * w[q]
+            S1[r, q] *= w[r] * w[q]
+            if S2 is not S1:
+                S2[r, q] *= w[r] * w[q]
+    lam, U = np.linalg.eigh(S0)
+    top = lam[ng - 1]
+    if not (top > 0.0):
+        return np.empty(0), np.empty((ng, 0))
+    keep = 0
+    for i in range(ng):
+        if lam[i] >= MAP_RANK_TOL * top:
+            keep += 1
+    return lam[ng - keep:].copy(), np.ascontiguousarray(U[:, ng - keep:])
+
+
+@njit(cache=True)
 def _map_radius(S, j, ng, first, ref):
     """``ρ`` of the least-squares one-step map ``R̂ = S1 S0⁻¹`` from bin ``first`` of
     slot ``j`` (the pairs before its level first fell below that bin), on the directions
@@ -562,32 +595,15 @@ def _map_radius(S, j, ng, first, ref):
         pairs = S[j, first, c]
     if pairs < 2.0 * ng:
         return math.nan, pairs
-    # Whitened (each component scaled to unit sum of squares) and restricted to the
-    # directions the pairs span: Baumgarte's law acts alike on every constraint, so the
-    # residual of m constraints moves in a plane of its 2m dimensions, and a fit over all
-    # of them gives the remaining directions the floor's dynamics.
-    w = np.zeros(ng)
-    for r in range(ng):
-        if S0[r, r] > 0.0:
-            w[r] = 1.0 / math.sqrt(S0[r, r])
-    for r in range(ng):
-        for q in range(ng):
-            S0[r, q] *= w[r] * w[q]
-            S1[r, q] *= w[r] * w[q]
-    lam, U = np.linalg.eigh(S0)
-    top = lam[ng - 1]
-    if not (top > 0.0):
+    lam, V = _spanned(S0, S1, S1)
+    keep = lam.shape[0]
+    if keep == 0:
         return math.nan, pairs
-    keep = 0
-    for i in range(ng):
-        if lam[i] >= MAP_RANK_TOL * top:
-            keep += 1
-    V = np.ascontiguousarray(U[:, ng - keep:])
     # R̂ on that subspace: (Vᵀ S1 V)(Vᵀ S0 V)⁻¹, Vᵀ S0 V the kept eigenvalues
     Rr = np.ascontiguousarray(V.T) @ S1 @ V
     for q in range(keep):
         for r in range(keep):
-            Rr[r, q] /= lam[ng - keep + q]
+            Rr[r, q] /= lam[q]
     return grouped_radius_of(Rr, ref), pairs
 
 
@@ -880,36 +896,22 @@ def _generator_full(s, ng, ref, h):
             P[r, c] = s[r * ng + c]
             Y[r, c] = s[n2 + r * ng + c]
             Z[r, c] = s[2 * n2 + r * ng + c]
-    w = np.zeros(ng)
-    for r in range(ng):
-        if P[r, r] > 0.0:
-            w[r] = 1.0 / math.sqrt(P[r, r])
-    for r in range(ng):
-        for c in range(ng):
-            P[r, c] *= w[r] * w[c]
-            Y[r, c] *= w[r] * w[c]
-            Z[r, c] *= w[r] * w[c]
-    lam, U = np.linalg.eigh(P)
-    top = lam[ng - 1]
-    if not (top > 0.0):
+    lam, V = _spanned(P, Y, Z)
+    keep = lam.shape[0]
+    if keep == 0:
         return math.nan
-    keep = 0
-    for i in range(ng):
-        if lam[i] >= MAP_RANK_TOL * top:
-            keep += 1
-    V = np.ascontiguousarray(U[:, ng - keep:])
     Vt = np.ascontiguousarray(V.T)
     Yr = Vt @ Y @ V
     Zr = Vt @ Z @ V
     Ar = Yr.copy()
     for r in range(keep):
         for c in range(keep):
-            Ar[r, c] = Yr[r, c] / lam[ng - keep + c]
+            Ar[r, c] = Yr[r, c] / lam[c]
     for _ in range(GENERATOR_SWEEPS):
         C = Yr + (Ar @ Ar) @ Zr / 12.0
         for r in range(keep):
             for c in range(keep):
-                Ar[r, c] = C[r, c] / lam[ng - keep + c]
+                Ar[r, c] = C[r, c] / lam[c]
     for r in range(keep):
         for c in range(keep):
             if not math.isfinite(Ar[r, c]):
