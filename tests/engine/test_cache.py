@@ -427,3 +427,53 @@ def test_a_damaged_numba_cache_entry_is_cleared_with_a_warning_that_names_it(tmp
     assert "numba's on-disk cache entry of forces in" in said and "was damaged" in said
     assert "Model" not in said
     assert "damaged" not in run()
+
+
+TWO_LAWS = textwrap.dedent(
+    """
+    import json, sys, warnings
+    import stabdae
+    sys.path.insert(0, str(__import__("pathlib").Path(sys.argv[1]).parent))
+    model = stabdae.load_model(sys.argv[1])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = {name: stabdae.integrate(model, None, law, "rk4", 1e-3, 0.3).x.values[-1].tolist()
+               for name, law in (("baumgarte", stabdae.baumgarte(10.0)),
+                                 ("acpr", stabdae.acpr(10.0)))}
+    print(json.dumps({"x": out, "warnings": [str(w.message) for w in caught]}))
+    """
+)
+
+
+def test_a_cache_entry_knows_which_kernel_it_is(model_folder, tmp_path):
+    """Two kernels' compiled code swapped between their cache files (the integrate loops
+    under two kinds of law), then one byte of an entry changed: each entry carries
+    the key of the kernel it belongs to and a checksum, so the next process compiles those
+    again, with one warning that names the cache, and gives the first process's numbers
+    (before: the stabilized run returned the unstabilized one's numbers)."""
+    cache = tmp_path / "cache"
+    env = dict(os.environ, STABDAE_CACHE_DIR=str(cache), PYTHONPATH=str(SRC))
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", TWO_LAWS, str(model_folder)], env=env,
+                             capture_output=True, text=True, timeout=300)  # fmt: skip
+        assert out.returncode == 0, out.stderr[-3000:]
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    first = run()
+    assert first["x"]["baumgarte"] != first["x"]["acpr"]
+    loops = sorted((cache / "kernels").glob("*integrate_kernel*.nbc"))
+    assert len(loops) == 2, loops
+    a, b = (p.read_bytes() for p in loops)
+    loops[0].write_bytes(b)
+    loops[1].write_bytes(a)
+    again = run()
+    assert again["x"] == first["x"]
+    assert any("cache" in w and "does not match" in w for w in again["warnings"]), again
+    data = bytearray(loops[0].read_bytes())  # rewritten by the run before
+    data[len(data) // 2] ^= 0x01
+    loops[0].write_bytes(bytes(data))
+    third = run()
+    assert third["x"] == first["x"]
+    assert any("does not match" in w for w in third["warnings"]), third
+    assert run()["warnings"] == []  # sound again

@@ -21,7 +21,9 @@ and not cached.
 The cache lives in ``$STABDAE_CACHE_DIR``, else ``$NUMBA_CACHE_DIR/stabdae``, else
 ``~/.cache/stabdae`` (``$XDG_CACHE_HOME`` honoured); ``STABDAE_CACHE_DIR=off`` disables it.
 Entries are written with numba's machinery (temporary file, then rename), so concurrent
-processes are safe.
+processes are safe.  Each compiled entry is headed by the key of the kernel it belongs to
+and a SHA-256 checksum: a damaged entry, or another kernel's put in its place, is compiled
+again (one warning naming the file), never run.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ import dataclasses
 import hashlib
 import inspect
 import os
+import pickle
 import shutil
 import sys
 import types
@@ -307,6 +310,42 @@ class _KeyedImpl(CompileResultCacheImpl):
         self._filename_base = self.get_filename_base(fullname, getattr(sys, "abiflags", ""))
 
 
+class _CheckedCacheFile(IndexDataCacheFile):
+    """numba's index and data files, each data file headed by what it is: the kernel's
+    key, its entry's file name and the SHA-256 of those and of the compiled code.  A data
+    file that does not match (damaged, cut short, or another kernel's swapped in) is
+    refused on load, so it is compiled again and rewritten, never run."""
+
+    _MAGIC = b"stabdae kernel cache entry 1\n"
+
+    def _digest(self, name: str, payload: bytes) -> str:
+        h = hashlib.sha256(self._source_stamp.encode())
+        h.update(b"\x00" + name.encode() + b"\x00")
+        h.update(payload)
+        return h.hexdigest()
+
+    def _save_data(self, name, data):
+        payload = self._dump(data)
+        head = f"{self._source_stamp} {name} {self._digest(name, payload)}\n".encode()
+        with self._open_for_write(self._data_path(name)) as f:
+            f.write(self._MAGIC + head + payload)
+
+    def _load_data(self, name):
+        path = self._data_path(name)
+        with open(path, "rb") as f:
+            raw = f.read()
+        head, _, payload = raw[len(self._MAGIC):].partition(b"\n")
+        want = f"{self._source_stamp} {name} {self._digest(name, payload)}".encode()
+        if not raw.startswith(self._MAGIC) or head != want:
+            raise _EntryMismatch(f"the cache entry {path} does not match its recorded key "
+                                 "and checksum (damaged, or another kernel's)")  # fmt: skip
+        return pickle.loads(payload)
+
+
+class _EntryMismatch(Exception):
+    pass
+
+
 class _KeyedCache(FunctionCache):
     """numba's function cache with an explicit key in place of the closure pickle."""
 
@@ -316,7 +355,7 @@ class _KeyedCache(FunctionCache):
         self._impl = _KeyedImpl(py_func, _KeyedLocator(py_func, key, path))
         self._cache_path = str(path)
         self._key = key
-        self._cache_file = IndexDataCacheFile(
+        self._cache_file = _CheckedCacheFile(
             cache_path=self._cache_path,
             filename_base=self._impl.filename_base,
             source_stamp=key,
