@@ -15,11 +15,13 @@ from ._codes import Status
 from ._integrate import IntegrationWarning, _multipliers
 from ._model import Model
 from ._schema import trajectory_dataset
+from .engine.crash import guarded
 from .engine.rk.adaptive import adaptive_for
 
 __all__ = ["integrate_adaptive"]
 
 
+@guarded("integrate_adaptive")
 def integrate_adaptive(
     model: Model,
     x0=None,

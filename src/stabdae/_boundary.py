@@ -38,6 +38,7 @@ from ._measures import (
     ensemble_verdict,
 )
 from ._schema import provenance, schema_variable, variable
+from .engine.crash import guarded
 from .engine.ensemble.block import BLOCK
 
 __all__ = ["boundary", "floor_limit"]
@@ -55,6 +56,7 @@ MIN_STEPS = 2000
 MAX_CONFIRM = 40
 
 
+@guarded("boundary")
 def boundary(
     model,
     law,

@@ -25,6 +25,7 @@ from ._codes import Status
 from ._ensemble_dataset import _ensemble_dataset, _warn_stopped
 from ._model import Model
 from ._raised import first_raising_member, model_raised
+from .engine.crash import guarded
 from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
 from .engine.ensemble.groups import (
@@ -68,6 +69,7 @@ STRIDE_CHANGE = 0.2
 
 
 # --------------------------------------------------------------------- sampling
+@guarded("sample_perturbations")
 def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0, *,
                          params=None, t0=None, threads=None):  # fmt: skip
     """Initial states ``x⁰`` with prescribed constraint perturbations ``g(x⁰, t0) = α⁰``.
@@ -162,6 +164,7 @@ def _threads(threads, who: str):
 
 
 # --------------------------------------------------------------------- driver
+@guarded("ensemble")
 def ensemble(
     model: Model,
     law,

@@ -14,6 +14,7 @@ from ._codes import Status
 from ._model import Model
 from ._raised import model_raised, replay_fixed
 from ._schema import trajectory_dataset
+from .engine.crash import guarded
 from .engine.rk.steps import integrator_for, multipliers_for
 
 __all__ = ["integrate", "IntegrationWarning"]
@@ -23,6 +24,7 @@ class IntegrationWarning(RuntimeWarning):
     """An integration stopped early; the dataset holds everything up to that step."""
 
 
+@guarded("integrate")
 def integrate(
     model: Model,
     x0=None,

@@ -1,0 +1,143 @@
+"""A message, instead of a bare "Segmentation fault", when a compiled kernel crashes.
+
+A model function that writes outside its ``out`` array at a state that ``Model()`` and
+``model.check()`` did not try (they run every function as Python and bounds-checked)
+corrupts memory in a compiled kernel, or makes the process die of a segmentation fault
+with nothing said.  Checking every index in the kernels costs their speed, so the
+default runs unchecked; while a public entry point (:func:`guarded`) runs, a handler of
+SIGSEGV and SIGBUS writes what happened and what to do to stderr and then hands the
+signal to the handler that was there before (Python's ``faulthandler``, if enabled, then
+prints the Python stack; otherwise the process dies as before).  The process is not
+saved: the memory may already be corrupt.
+
+The handler is a numba ``cfunc`` that calls only ``write``, ``strlen`` and ``sigaction``
+(async-signal-safe), compiled once per process on the first guarded call (about 0.4 s: the
+addresses it writes from are this process's).  Linux only; elsewhere, or with
+``STABDAE_CRASH_MESSAGE=off``, nothing is installed.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import os
+import signal
+import sys
+import threading
+
+__all__ = ["guarded"]
+
+_SIGNALS = (signal.SIGSEGV, signal.SIGBUS) if hasattr(signal, "SIGBUS") else (signal.SIGSEGV,)
+#: glibc's struct sigaction is 152 bytes on x86-64 and aarch64: room to spare
+_ACTION_BYTES = 256
+_FLAGS_OFFSET = 8 + 128  # after sa_handler and the 1024-bit sa_mask
+_SA_ONSTACK = 0x08000000
+
+_LOCK = threading.Lock()
+_state = {"depth": 0, "handler": None, "failed": False}
+_MESSAGE = ctypes.create_string_buffer(4096)
+_OLD = {sig: (ctypes.c_char * _ACTION_BYTES)() for sig in _SIGNALS}
+_NEW = (ctypes.c_char * _ACTION_BYTES)()
+
+
+def _message(who: str) -> bytes:
+    return (
+        f"\nstabdae: {who} crashed inside a compiled kernel (a segmentation fault or bus "
+        "error): most likely a model or law function read or wrote outside its arrays at a "
+        "state that Model() and model.check() did not try.  Run it again with "
+        "NUMBA_BOUNDSCHECK=1 in the environment: it then stops with an IndexError that "
+        "names the function, the time and the state.  (The grid points a study has "
+        "finished are kept: the same command resumes.)\n"
+    ).encode()[: len(_MESSAGE) - 1]
+
+
+def _enabled() -> bool:
+    from numba import config
+
+    off = os.environ.get("STABDAE_CRASH_MESSAGE", "").strip().lower() in ("0", "off", "no")
+    return sys.platform.startswith("linux") and not off and not config.DISABLE_JIT
+
+
+def _libc_functions():
+    libc = ctypes.CDLL(None)
+
+    def fn(name, restype, *argtypes):  # pointers passed as size_t: numba takes integers
+        f = getattr(libc, name)
+        f.argtypes, f.restype = list(argtypes), restype
+        return f
+
+    size_t = ctypes.c_size_t
+    return (fn("write", ctypes.c_ssize_t, ctypes.c_int, size_t, size_t),
+            fn("strlen", size_t, size_t),
+            fn("sigaction", ctypes.c_int, ctypes.c_int, size_t, size_t))  # fmt: skip
+
+
+def _compile_handler():
+    from numba import cfunc, types
+
+    c_write, c_strlen, c_sigaction = _libc_functions()
+    text = ctypes.addressof(_MESSAGE)
+    segv = int(signal.SIGSEGV)
+    old_segv = ctypes.addressof(_OLD[signal.SIGSEGV])
+    old_other = ctypes.addressof(_OLD[_SIGNALS[-1]])
+
+    @cfunc(types.void(types.int32))
+    def handler(sig):
+        c_write(2, text, c_strlen(text))
+        # the handler before ours takes over; the faulting instruction runs again on return
+        c_sigaction(sig, old_segv if sig == segv else old_other, 0)
+
+    return handler, c_sigaction
+
+
+def _install(who: str) -> None:
+    if _state["handler"] is None:
+        _state["handler"] = _compile_handler()
+    handler, c_sigaction = _state["handler"]
+    _MESSAGE.value = _message(who)
+    ctypes.memset(_NEW, 0, _ACTION_BYTES)
+    ctypes.memmove(_NEW, ctypes.byref(ctypes.c_size_t(handler.address)), 8)
+    flags = ctypes.c_int(_SA_ONSTACK)  # on faulthandler's stack, where it has set one up
+    ctypes.memmove(ctypes.addressof(_NEW) + _FLAGS_OFFSET, ctypes.byref(flags), 4)
+    for sig in _SIGNALS:
+        if c_sigaction(int(sig), ctypes.addressof(_NEW), ctypes.addressof(_OLD[sig])) != 0:
+            raise OSError(f"sigaction({int(sig)}) failed")
+
+
+def _restore() -> None:
+    _, c_sigaction = _state["handler"]
+    for sig in _SIGNALS:
+        c_sigaction(int(sig), ctypes.addressof(_OLD[sig]), 0)
+
+
+def guarded(who: str):
+    """Decorator: while the function runs (outermost call only), a crash in a compiled
+    kernel prints what happened and what to do before the process dies."""
+
+    def wrap(fn):
+        @functools.wraps(fn)
+        def run(*args, **kwargs):
+            entered = False
+            with _LOCK:
+                if _state["depth"] == 0 and not _state["failed"] and _enabled():
+                    try:
+                        _install(who)
+                        entered = True
+                    except Exception:  # no libc, no numba cfunc: run without the message
+                        _state["failed"] = True
+                elif _state["depth"] > 0:
+                    entered = True
+                if entered:
+                    _state["depth"] += 1
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                if entered:
+                    with _LOCK:
+                        _state["depth"] -= 1
+                        if _state["depth"] == 0:
+                            _restore()
+
+        return run
+
+    return wrap
