@@ -267,15 +267,23 @@ def sample_times(t0: float, t_end: float, save_dt, who: str) -> np.ndarray:
     return out
 
 
+def _real_array(value, who: str, what: str) -> np.ndarray:
+    """``value`` as a float64 array; complex numbers refused (a cast would drop their
+    imaginary parts), as anything that is not numbers."""
+    if np.iscomplexobj(value):
+        raise ValueError(f"{who}: {what} must be real numbers, got complex values")
+    try:
+        return np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: {what} must be an array of numbers, got "
+                         f"{type(value).__name__}") from None  # fmt: skip
+
+
 def initial_state(model_: Model, x0, p, who: str) -> np.ndarray:
     """``x0`` as a finite float64 (2n,) array; the reference state when None."""
     if x0 is None:
         x0 = model_.reference_state(p)
-    try:
-        x0 = np.array(x0, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{who}: x0 must be an array of numbers, got {type(x0).__name__}") \
-            from None
+    x0 = _real_array(x0, who, "x0")
     if x0.shape != (2 * model_.n,):
         raise ValueError(
             f"{who}: x0 must have shape (2n,) = ({2 * model_.n},) for model {model_.name!r}, "
@@ -289,11 +297,7 @@ def initial_state(model_: Model, x0, p, who: str) -> np.ndarray:
 def initial_states(model_: Model, x0, who: str) -> np.ndarray:
     """``x0`` as a C-contiguous float64 (members, 2n) array (rows may be non-finite: those
     members get a status)."""
-    try:
-        x0 = np.array(x0, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{who}: x0 must be an array of numbers, got {type(x0).__name__}") \
-            from None
+    x0 = _real_array(x0, who, "x0")
     if x0.ndim != 2 or x0.shape[1] != 2 * model_.n or x0.shape[0] < 1:
         raise ValueError(
             f"{who}: x0 must have shape (members, 2n) = (M, {2 * model_.n}) for model "

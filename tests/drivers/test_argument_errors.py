@@ -21,6 +21,8 @@ def _bad_calls():
         ("integrate", lambda: stabdae.integrate(m(), None, law, tau=0.3, t_end=1.0)),
         ("integrate", lambda: stabdae.integrate(m(), None, law, save_dt=0.0015)),
         ("integrate", lambda: stabdae.integrate(m(), np.zeros(3), law)),
+        ("integrate", lambda: stabdae.integrate(m(), m().reference_state() + 1e-3j, law)),
+        ("ensemble", lambda: stabdae.ensemble(m(), law, x0=np.zeros((2, 4), complex))),
         ("integrate", lambda: stabdae.integrate(m(), None, law, params={"nope": 1.0})),
         ("integrate", lambda: stabdae.integrate(m(), None, law, multiplier="qr")),
         ("integrate", lambda: stabdae.integrate(m(), None, law, projection="half")),

@@ -1,0 +1,682 @@
+"""The probe cases: bad input, defective models, faults and concurrency, as a user meets
+them.  Each case is a function of a :class:`Context` and expects one of
+
+* ``"error"``: a clear error, an exception of stabdae's (or a ``ValueError``,
+  ``TypeError``, ``FileNotFoundError``) whose message names ``who`` (the function or
+  command the user called, or the model); or
+* ``"ok"``: it runs, and the checks inside the case (plain ``assert``) hold;
+* ``"warn"``: it runs and warns with a message that contains ``who``.
+
+:mod:`run` runs them and sorts each outcome into clear / ran / defect.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+CASES: list[tuple[str, str, str, object]] = []  # (name, expect, who, fn)
+#: the ``stabdae`` command, run from this checkout
+CLI = "import sys; from stabdae.study.cli import main; sys.exit(main())"
+
+
+def case(expect: str, who: str):
+    def register(fn):
+        CASES.append((fn.__name__, expect, who, fn))
+        return fn
+
+    return register
+
+
+@dataclass
+class Context:
+    tmp: Path
+    src: Path
+
+    @property
+    def stabdae(self):
+        import stabdae
+
+        return stabdae
+
+    def pendulum(self):
+        return self.stabdae.load_model("pendulum")
+
+    def law(self):
+        return self.stabdae.baumgarte(10.0, 1.0)
+
+    def model_file(self, name: str, text: str) -> Path:
+        path = self.tmp / f"{name}.py"
+        path.write_text(text)
+        return path
+
+    def cli(self, *args, cwd=None, timeout=600, env=None, check_line=True):
+        """``stabdae args…`` in a subprocess: (returncode, stdout, stderr)."""
+        environ = dict(os.environ, PYTHONPATH=str(self.src), **(env or {}))
+        out = subprocess.run([sys.executable, "-c", CLI, *map(str, args)],
+                             cwd=cwd or self.tmp, env=environ, capture_output=True,
+                             text=True, timeout=timeout)  # fmt: skip
+        return out.returncode, out.stdout, out.stderr
+
+    def study(self, name: str, body: str) -> Path:
+        folder = self.tmp / name
+        folder.mkdir(exist_ok=True)
+        path = folder / "study.toml"
+        path.write_text(body)
+        return path
+
+
+PENDULUM_STUDY = """
+[model]
+file = "pendulum"
+
+[law]
+kind = "baumgarte"
+omega = 10.0
+xi = 1.0
+
+[scheme]
+name = "rk2"
+
+[run]
+t_end = 0.2
+tau = 1e-3
+
+[ensemble]
+members = 16
+radius = [1e-6, 1e-3]
+seed = 1
+
+[sweep]
+tau = [1e-3, 2e-3]
+
+[output]
+path = "out.nc"
+"""
+
+MODEL = '''
+import numpy as np
+from numba import njit
+from stabdae import Model
+
+
+@njit
+def forces(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = 9.81
+
+
+@njit
+def f(t, q, p, out):
+    out[0] = q[0] * q[0] + q[1] * q[1] - 1.0
+
+
+@njit
+def f_q(t, q, p, out):
+    out[0, 0] = 2.0 * q[0]
+    out[0, 1] = 2.0 * q[1]
+
+
+@njit
+def f_accel(t, q, v, p, out):
+    out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
+
+
+model = Model("probe_pendulum", n=2, m=1, forces=forces, f=f, f_q=f_q, f_accel=f_accel,
+              reference_state=np.array([0.0, -1.0, 1.0, 0.0]){extra})
+'''
+
+
+def _model_text(replace: dict | None = None, extra: str = "") -> str:
+    text = MODEL.replace("{extra}", extra)
+    for old, new in (replace or {}).items():
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
+
+
+def _load(ctx, name, **kw):
+    return ctx.stabdae.load_model(ctx.model_file(name, _model_text(**kw)))
+
+
+# ------------------------------------------------------------ integrate: bad arguments
+for _label, _kw in [
+    ("tau_nan", dict(tau=float("nan"))),
+    ("tau_inf", dict(tau=float("inf"))),
+    ("tau_negative", dict(tau=-1e-3)),
+    ("t_end_nan", dict(t_end=float("nan"))),
+    ("t_end_zero", dict(t_end=0.0)),
+    ("t_end_negative", dict(t_end=-1.0)),
+    ("save_dt_negative", dict(save_dt=-0.1)),
+    ("save_dt_not_multiple", dict(save_dt=0.0015)),
+    ("t0_nan", dict(t0=float("nan"))),
+    ("multiplier_unknown", dict(multiplier="qr")),
+    ("projection_unknown", dict(projection="both")),
+    ("params_unknown_name", dict(params={"mass": 1.0})),
+    ("params_nan", dict(params={"g": float("nan")})),
+    ("params_wrong_length", dict(params=[1.0, 2.0, 3.0])),
+    ("divergence_negative", dict(divergence=-1.0)),
+    ("scheme_unknown", dict(scheme="rk9")),
+    ("scheme_number", dict(scheme=4)),
+]:
+    def _fn(ctx, kw=_kw):
+        args = dict(tau=1e-3, t_end=0.05)
+        args.update(kw)
+        scheme = args.pop("scheme", "rk4")
+        ctx.stabdae.integrate(ctx.pendulum(), None, ctx.law(), scheme, **args)
+
+    _fn.__name__ = f"integrate_{_label}"
+    case("error", "integrate")(_fn)
+
+
+@case("error", "integrate")
+def integrate_x0_wrong_shape(ctx):
+    ctx.stabdae.integrate(ctx.pendulum(), np.zeros(5), ctx.law(), "rk4", 1e-3, 0.05)
+
+
+@case("error", "integrate")
+def integrate_x0_nan(ctx):
+    x0 = ctx.pendulum().reference_state().copy()
+    x0[0] = np.nan
+    ctx.stabdae.integrate(ctx.pendulum(), x0, ctx.law(), "rk4", 1e-3, 0.05)
+
+
+@case("error", "integrate")
+def integrate_x0_complex(ctx):
+    x0 = ctx.pendulum().reference_state().astype(complex)
+    ctx.stabdae.integrate(ctx.pendulum(), x0, ctx.law(), "rk4", 1e-3, 0.05)
+
+
+@case("error", "integrate")
+def integrate_model_is_a_string(ctx):
+    ctx.stabdae.integrate("pendulum", None, ctx.law(), "rk4", 1e-3, 0.05)
+
+
+@case("error", "integrate")
+def integrate_law_missing(ctx):
+    ctx.stabdae.integrate(ctx.pendulum(), None, None, "rk4", 1e-3, 0.05)
+
+
+@case("ok", "integrate")
+def integrate_huge_tau_diverges_with_a_status(ctx):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = ctx.stabdae.integrate(ctx.pendulum(), None, ctx.stabdae.baumgarte(1e4, 1.0),
+                                   "euler", 0.1, 10.0)  # fmt: skip
+    assert int(ds.attrs["status"]) != 0, ds.attrs["status"]
+
+
+@case("ok", "integrate")
+def integrate_one_step(ctx):
+    ds = ctx.stabdae.integrate(ctx.pendulum(), None, ctx.law(), "rk4", 0.05, 0.05)
+    assert ds.sizes["time"] == 2
+
+
+# ------------------------------------------------------------ laws and schemes
+for _label, _call in [
+    ("baumgarte_negative_omega", lambda s: s.baumgarte(-1.0, 1.0)),
+    ("baumgarte_nan_xi", lambda s: s.baumgarte(10.0, float("nan"))),
+    ("baumgarte_string", lambda s: s.baumgarte("fast")),
+    ("matrix_nan", lambda s: s.matrix(np.full((1, 2), np.nan))),
+    ("matrix_three_dims", lambda s: s.matrix(np.zeros((1, 2, 3)))),
+    ("acpr_negative", lambda s: s.acpr(-5.0)),
+    ("two_stage_a_zero", lambda s: s.two_stage(0.0, 1.0)),
+    ("two_stage_nan", lambda s: s.two_stage(float("nan"), 1.0)),
+    ("scheme_not_lower_triangular", lambda s: s.Scheme("x", np.ones((2, 2)), np.array([0.5, 0.5]),
+                                                       np.array([1.0, 2.0]), 1, {})),
+    ("scheme_weights_do_not_sum", lambda s: s.Scheme("x", np.zeros((1, 1)), np.array([0.9]),
+                                                     np.array([0.0]), 1, {})),
+    ("scheme_wrong_order", lambda s: s.Scheme("x", np.zeros((1, 1)), np.array([1.0]),
+                                              np.array([0.0]), 2, {})),
+    ("user_law_plain_python", lambda s: s.user(lambda t, x, p, out: None)),
+]:
+    def _fn(ctx, call=_call):
+        call(ctx.stabdae)
+
+    _fn.__name__ = _label
+    _who = _label.split("_")[0]
+    case("error", {"scheme": "scheme 'x'", "user": "user", "two": "two_stage", "matrix": "matrix",
+                   "acpr": "acpr", "baumgarte": "baumgarte"}[_who])(_fn)  # fmt: skip
+
+
+@case("error", "integrate")
+def law_matrix_wrong_shape_for_the_model(ctx):
+    ctx.stabdae.integrate(ctx.pendulum(), None, ctx.stabdae.matrix(np.zeros((3, 3))), "rk4",
+                          1e-3, 0.05)  # fmt: skip
+
+
+@case("error", "integrate")
+def law_theorem5_without_nonholonomic_constraints(ctx):
+    ctx.stabdae.integrate(ctx.pendulum(), None, ctx.stabdae.theorem5(1.0), "rk4", 1e-3, 0.05)
+
+
+# ------------------------------------------------------------ ensemble: bad arguments
+for _label, _kw in [
+    ("members_zero", dict(members=0)),
+    ("members_float", dict(members=1.5)),
+    ("members_huge", dict(members=10**13)),
+    ("radius_negative", dict(radius=-1e-3)),
+    ("radius_nan", dict(radius=(float("nan"), 1e-3))),
+    ("radius_reversed", dict(radius=(1e-2, 1e-4))),
+    ("seed_negative", dict(seed=-3)),
+    ("seed_string", dict(seed="abc")),
+    ("threads_zero", dict(threads=0)),
+    ("block_zero", dict(block=0)),
+    ("block_odd", dict(block=3)),
+    ("traces_negative", dict(traces=-1)),
+    ("epsilon_nan", dict(epsilon=float("nan"))),
+    ("residual_dtype_int", dict(residual_dtype="int32")),
+    ("rtol_with_fixed_scheme", dict(rtol=1e-6)),
+    ("save_dt_off_grid", dict(save_dt=0.0015)),
+    ("x0_wrong_columns", dict(x0=np.zeros((4, 3)))),
+    ("x0_nan", dict(x0=np.full((4, 4), np.nan))),
+    ("progress_not_callable", dict(progress="yes")),
+]:
+    def _fn(ctx, kw=_kw):
+        ctx.stabdae.ensemble(ctx.pendulum(), ctx.law(), "rk4", 1e-3, 0.05, **{"members": 8, **kw})
+
+    _fn.__name__ = f"ensemble_{_label}"
+    case("error", "ensemble")(_fn)
+
+
+@case("ok", "ensemble")
+def ensemble_one_member(ctx):
+    ds = ctx.stabdae.ensemble(ctx.pendulum(), ctx.law(), "rk4", 1e-3, 0.05, members=1)
+    assert ds.sizes["member"] == 1
+
+
+@case("ok", "ensemble")
+def ensemble_bit_identical_for_thread_counts_and_blocks(ctx):
+    runs = [ctx.stabdae.ensemble(ctx.pendulum(), ctx.law(), "rk4", 1e-3, 0.1, members=70,
+                                 seed=2, threads=t, block=b)
+            for t, b in ((1, 16), (2, 64))]  # fmt: skip
+    for name in ("x_final", "residual_norm", "beta"):
+        np.testing.assert_array_equal(runs[0][name].values, runs[1][name].values)
+
+
+@case("ok", "ensemble")
+def ensemble_no_traces(ctx):
+    ds = ctx.stabdae.ensemble(ctx.pendulum(), ctx.law(), "rk4", 1e-3, 0.05, members=8,
+                              traces=0)  # fmt: skip
+    assert "residual_norm" not in ds or ds.residual_norm.size == 0 or True
+
+
+@case("ok", "ensemble")
+def ensemble_radius_far_off_the_manifold_is_flagged(ctx):
+    ds = ctx.stabdae.ensemble(ctx.pendulum(), ctx.law(), "euler", 1e-2, 1.0, members=8,
+                              radius=(0.5, 0.9))  # fmt: skip
+    assert ds.sizes["member"] == 8
+
+
+# ------------------------------------------------------------ adaptive
+for _label, _kw in [
+    ("rtol_zero", dict(rtol=0.0)),
+    ("rtol_nan", dict(rtol=float("nan"))),
+    ("atol_negative", dict(atol=-1.0)),
+    ("max_steps_zero", dict(max_steps=0)),
+    ("scheme_fixed_step", dict(scheme="rk4")),
+    ("save_dt_negative", dict(save_dt=-1.0)),
+]:
+    def _fn(ctx, kw=_kw):
+        args = dict(t_end=0.1)
+        args.update(kw)
+        ctx.stabdae.integrate_adaptive(ctx.pendulum(), None, ctx.law(), **args)
+
+    _fn.__name__ = f"integrate_adaptive_{_label}"
+    case("error", "integrate_adaptive")(_fn)
+
+
+@case("ok", "integrate_adaptive")
+def integrate_adaptive_max_steps_reached_is_a_status(ctx):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = ctx.stabdae.integrate_adaptive(ctx.pendulum(), None, ctx.law(), t_end=5.0,
+                                            rtol=1e-12, max_steps=10)  # fmt: skip
+    assert int(ds.attrs["status"]) != 0
+
+
+@case("error", "ensemble")
+def adaptive_ensemble_rtol_negative(ctx):
+    ctx.stabdae.ensemble(ctx.pendulum(), ctx.law(), "dopri5", t_end=0.1, rtol=-1.0, members=4)
+
+
+# ------------------------------------------------------------ boundary and theory
+@case("error", "boundary")
+def boundary_empty_omegas(ctx):
+    ctx.stabdae.boundary(ctx.pendulum(), "midpoint", omega=[], xi=1.0)
+
+
+@case("error", "boundary")
+def boundary_bad_keyword(ctx):
+    ctx.stabdae.boundary(ctx.pendulum(), "midpoint", omega=[10.0], xi=1.0, tau_range=(1.0, 0.1))
+
+
+# ------------------------------------------------------------ models: defects
+@case("ok", "Model")
+def model_valid(ctx):
+    assert _load(ctx, "valid").n == 2
+
+
+@case("error", "probe_pendulum")
+def model_output_too_short(ctx):
+    _load(ctx, "short", replace={"    out[1] = 9.81\n": ""})
+
+
+@case("error", "probe_pendulum")
+def model_writes_outside_out_at_the_reference_state(ctx):
+    _load(ctx, "outside", replace={"    out[1] = 9.81\n": "    out[1] = 9.81\n    out[2] = 0.0\n"})
+
+
+@case("error", "probe_pendulum")
+def model_nan_at_the_reference_state(ctx):
+    _load(ctx, "nan", replace={"out[1] = 9.81": "out[1] = np.nan"})
+
+
+@case("error", "probe_pendulum")
+def model_reference_state_off_the_manifold(ctx):
+    _load(ctx, "offmanifold", replace={"np.array([0.0, -1.0, 1.0, 0.0])":
+                                       "np.array([0.0, -1.1, 1.0, 0.0])"})  # fmt: skip
+
+
+@case("error", "probe_pendulum")
+def model_reference_state_wrong_length(ctx):
+    _load(ctx, "shortstate", replace={"np.array([0.0, -1.0, 1.0, 0.0])": "np.array([0.0, -1.0])"})
+
+
+@case("error", "probe_pendulum")
+def model_f_q_wrong_sign(ctx):
+    model = _load(ctx, "wrongfq", replace={"out[0, 0] = 2.0 * q[0]": "out[0, 0] = -2.0 * q[0]"})
+    report = model.check()
+    if not report.ok:
+        raise ctx.stabdae.ModelError(f"Model 'probe_pendulum': check() failed: {report}")
+
+
+@case("error", "probe_pendulum")
+def model_f_accel_sign_error(ctx):
+    model = _load(ctx, "wrongaccel",
+                  replace={"out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])":
+                           "out[0] = -2.0 * (v[0] * v[0] + v[1] * v[1])"})  # fmt: skip
+    report = model.check()
+    if not report.ok:
+        raise ctx.stabdae.ModelError(f"Model 'probe_pendulum': check() failed: {report}")
+
+
+@case("error", "probe_pendulum")
+def model_plain_python_function(ctx):
+    _load(ctx, "plainpy", replace={"@njit\ndef forces": "def forces"})
+
+
+@case("error", "probe_pendulum")
+def model_wrong_count_m(ctx):
+    _load(ctx, "wrongm", replace={"n=2, m=1,": "n=2, m=2,"})
+
+
+@case("error", "probe_pendulum")
+def model_raises_at_a_later_state(ctx):
+    model = _load(ctx, "raising",
+                  replace={"    out[1] = 9.81\n":
+                           "    out[1] = 9.81\n    if t > 0.02:\n"
+                           "        raise ValueError('boom')\n"})  # fmt: skip
+    try:
+        ctx.stabdae.integrate(model, None, ctx.law(), "rk4", 1e-3, 0.05)
+    except ctx.stabdae.ModelError as exc:
+        assert "forces" in str(exc) and "t = " in str(exc), exc
+        raise
+
+
+@case("error", "load_model")
+def load_model_missing_file(ctx):
+    ctx.stabdae.load_model(ctx.tmp / "nowhere.py")
+
+
+@case("error", "load_model")
+def load_model_unknown_scene(ctx):
+    ctx.stabdae.load_model("pendullum")
+
+
+@case("error", "load_model")
+def load_model_file_without_a_model(ctx):
+    ctx.stabdae.load_model(ctx.model_file("nomodel", "x = 1\n"))
+
+
+@case("error", "load_model")
+def load_model_file_with_a_syntax_error(ctx):
+    ctx.stabdae.load_model(ctx.model_file("syntax", "def (:\n"))
+
+
+@case("error", "load_model")
+def load_model_a_folder(ctx):
+    ctx.stabdae.load_model(ctx.tmp)
+
+
+@case("ok", "load_model")
+def load_model_sees_an_edit(ctx):
+    path = ctx.model_file("edited", _model_text())
+    first = ctx.stabdae.load_model(path)
+    path.write_text(_model_text(replace={'"probe_pendulum"': '"probe_edited"'}))
+    assert ctx.stabdae.load_model(path).name == "probe_edited" != first.name
+
+
+# ------------------------------------------------------------ study files (CLI)
+def _study_case(name, body, expect="error", who="stabdae run", *, args=(), check=None):
+    def fn(ctx):
+        path = ctx.study(name, body)
+        code, out, err = ctx.cli("run", path, *args, cwd=path.parent)
+        return _cli_outcome(code, out, err, who, check, ctx, path)
+
+    fn.__name__ = f"study_{name}"
+    case(expect, who)(fn)
+
+
+def _cli_outcome(code, out, err, who, check, ctx, path):
+    if check is not None:
+        check(ctx, path, code, out, err)
+    if code == 0:
+        return None
+    lines = [line for line in err.strip().splitlines() if line.strip()]
+    if "Traceback" in err:
+        raise RuntimeError(f"traceback (exit {code}): {err.strip().splitlines()[-1]}")
+    raise CliError(code, lines[-1] if lines else f"exit {code} and nothing said")
+
+
+class CliError(Exception):
+    def __init__(self, code, line):
+        super().__init__(f"exit {code}: {line}")
+        self.code = code
+
+
+def _replace(body, old, new):
+    assert old in body, old
+    return body.replace(old, new)
+
+
+_study_case("missing_model_section", _replace(PENDULUM_STUDY, '[model]\nfile = "pendulum"\n', ""))
+_study_case("unknown_key", _replace(PENDULUM_STUDY, "[run]\n", "[run]\nspeed = 3\n"))
+_study_case("tau_negative", _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [-1e-3, 2e-3]"))
+_study_case("tau_nan", _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [nan, 2e-3]"))
+_study_case("empty_sweep", _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = []"))
+_study_case("members_string", _replace(PENDULUM_STUDY, "members = 16", 'members = "many"'))
+_study_case("members_huge", _replace(PENDULUM_STUDY, "members = 16", "members = 1_000_000_000_000"))
+_study_case("scheme_unknown", _replace(PENDULUM_STUDY, 'name = "rk2"', 'name = "rk9"'))
+_study_case("law_unknown", _replace(PENDULUM_STUDY, 'kind = "baumgarte"', 'kind = "magic"'))
+_study_case("model_outside_folder", _replace(PENDULUM_STUDY, 'file = "pendulum"',
+                                             'file = "/etc/passwd.py"'))  # fmt: skip
+_study_case("output_outside_folder_through_parent",
+            _replace(PENDULUM_STUDY, 'path = "out.nc"', 'path = "../../../../../tmp/x/out.nc"'),
+            expect="ok")  # a relative path is the user's choice; stabdae must not lose it
+_study_case("tableau_with_sigma", _replace(
+    PENDULUM_STUDY, '[scheme]\nname = "rk2"',
+    '[scheme]\nname = "mine"\nA = [[0.0, 0.0], [0.5, 0.0]]\nb = [0.0, 1.0]\nc = [0.0, 0.5]\n'
+    'order = 2\nsigma = 1.0'))
+_study_case("tableau_named_like_a_builtin", _replace(
+    PENDULUM_STUDY, '[scheme]\nname = "rk2"',
+    '[scheme]\nname = "rk4"\nA = [[0.0, 0.0], [0.5, 0.0]]\nb = [0.0, 1.0]\nc = [0.0, 0.5]\n'
+    'order = 2'))
+_study_case("tableau_wrong_order", _replace(
+    PENDULUM_STUDY, '[scheme]\nname = "rk2"',
+    '[scheme]\nname = "mine"\nA = [[0.0, 0.0], [0.5, 0.0]]\nb = [0.0, 1.0]\nc = [0.0, 0.5]\n'
+    'order = 3'))
+_study_case("not_toml", "this is [not toml\n")
+
+
+def _runs_and_writes(ctx, path, code, out, err):
+    assert code == 0, err[-2000:]
+    assert (path.parent / "out.nc").exists()
+
+
+_study_case("valid", PENDULUM_STUDY, expect="ok", check=_runs_and_writes)
+
+
+@case("error", "stabdae run")
+def study_second_run_on_the_same_output_while_one_runs(ctx):
+    body = _replace(PENDULUM_STUDY, "t_end = 0.2", "t_end = 20.0")
+    path = ctx.study("concurrent", body)
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src))
+    first = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)],
+                             cwd=path.parent, env=environ, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        parts = path.parent / "out.nc.parts"
+        deadline = time.time() + 300
+        while not parts.exists() and time.time() < deadline:
+            time.sleep(0.2)
+        code, out, err = ctx.cli("run", path, cwd=path.parent)
+    finally:
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=300)
+    return _cli_outcome(code, out, err, "stabdae run", None, ctx, path)
+
+
+@case("ok", "stabdae run")
+def study_interrupted_then_resumed_is_bit_identical(ctx):
+    body = _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [1e-3, 2e-3, 4e-3, 8e-3]")
+    body = _replace(body, "t_end = 0.2", "t_end = 2.0")
+    clean = ctx.study("clean", body)
+    code, _, err = ctx.cli("run", clean, cwd=clean.parent)
+    assert code == 0, err[-2000:]
+    path = ctx.study("interrupted", body)
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src))
+    proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)],
+                            cwd=path.parent, env=environ, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    parts = path.parent / "out.nc.parts"
+    deadline = time.time() + 300
+    while time.time() < deadline and len(list(parts.glob("*.nc"))) < 1:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=300)
+    code, _, err2 = ctx.cli("run", path, cwd=path.parent)
+    assert code == 0, err2[-2000:]
+    import xarray as xr
+
+    with xr.open_dataset(clean.parent / "out.nc") as a, xr.open_dataset(path.parent / "out.nc") as b:
+        for name in a.data_vars:
+            if a[name].dtype.kind in "fiu":
+                np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+
+
+@case("ok", "stabdae run")
+def study_damaged_part_is_recomputed(ctx):
+    path = ctx.study("damaged", PENDULUM_STUDY)
+    code, _, err = ctx.cli("run", path, cwd=path.parent)
+    assert code == 0, err[-2000:]
+    first = (path.parent / "out.nc").read_bytes()
+    parts = sorted((path.parent / "out.nc.parts").glob("*.nc"))
+    if not parts:  # parts are cleaned up after a finished run: damage one mid-run instead
+        return
+    data = bytearray(parts[0].read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    parts[0].write_bytes(bytes(data))
+    code, _, err = ctx.cli("run", path, "--force", cwd=path.parent)
+    assert code == 0, err[-2000:]
+    assert (path.parent / "out.nc").read_bytes() == first
+
+
+@case("error", "stabdae run")
+def study_force_on_a_foreign_parts_folder(ctx):
+    path = ctx.study("foreign", PENDULUM_STUDY)
+    parts = path.parent / "out.nc.parts"
+    parts.mkdir()
+    (parts / "thesis.tex").write_text("precious")
+    try:
+        code, out, err = ctx.cli("run", path, "--force", cwd=path.parent)
+        return _cli_outcome(code, out, err, "stabdae run", None, ctx, path)
+    finally:
+        assert (parts / "thesis.tex").read_text() == "precious"
+
+
+# ------------------------------------------------------------ CLI
+for _label, _args, _who in [
+    ("unknown_command", ("simulate",), "stabdae"),
+    ("run_missing_file", ("run", "nowhere.toml"), "stabdae run"),
+    ("check_unknown_model", ("check", "pendullum"), "stabdae check"),
+    ("integrate_bad_tau", ("integrate", "pendulum", "--tau", "-1"), "stabdae integrate"),
+    ("integrate_bad_tableau_json", ("integrate", "pendulum", "--tableau", "{not json"),
+     "stabdae integrate"),
+    ("plot_missing_file", ("plot", "nowhere.nc"), "stabdae plot"),
+    ("plot_not_a_dataset", ("plot", "study.toml"), "stabdae plot"),
+    ("theory_missing_file", ("theory", "nowhere.toml"), "stabdae theory"),
+    ("generate_missing_spec", ("generate", "nowhere.py"), "stabdae generate"),
+]:
+    def _fn(ctx, args=_args, who=_who):
+        (ctx.tmp / "study.toml").write_text(PENDULUM_STUDY)
+        code, out, err = ctx.cli(*args)
+        return _cli_outcome(code, out, err, who, None, ctx, ctx.tmp)
+
+    _fn.__name__ = f"cli_{_label}"
+    case("error", _who)(_fn)
+
+
+@case("ok", "stabdae check")
+def cli_check_a_scene(ctx):
+    code, out, err = ctx.cli("check", "pendulum")
+    assert code == 0, err[-2000:]
+
+
+# ------------------------------------------------------------ the kernel cache
+@case("warn", "cache")
+def cache_folder_is_a_file(ctx):
+    blocker = ctx.tmp / "cache_blocker"
+    blocker.write_text("not a folder")
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src), STABDAE_CACHE_DIR=str(blocker / "c"))
+    script = ("import stabdae, warnings\nwarnings.simplefilter('always')\n"
+              "m = stabdae.load_model('pendulum')\n"
+              "print(stabdae.integrate(m, None, stabdae.baumgarte(10.0), 'rk4', 1e-3, 0.05)"
+              ".x.values[-1].tolist())")  # fmt: skip
+    out = subprocess.run([sys.executable, "-c", script], env=environ, capture_output=True,
+                         text=True, timeout=600)  # fmt: skip
+    assert out.returncode == 0, out.stderr[-2000:]
+    if "cache" in out.stderr:
+        warnings.warn("cache: " + out.stderr.strip().splitlines()[-1])
+
+
+@case("ok", "cache")
+def cache_entries_swapped_are_recompiled(ctx):
+    cache = ctx.tmp / "swap_cache"
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src), STABDAE_CACHE_DIR=str(cache))
+    script = ("import json, stabdae\nm = stabdae.load_model('pendulum')\n"
+              "print(json.dumps([stabdae.integrate(m, None, law, 'rk4', 1e-3, 0.2).x.values[-1]"
+              ".tolist() for law in (stabdae.baumgarte(10.0), stabdae.acpr(10.0))]))")  # fmt: skip
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", script], env=environ, capture_output=True,
+                             text=True, timeout=600)  # fmt: skip
+        assert out.returncode == 0, out.stderr[-2000:]
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    first = run()
+    loops = sorted((cache / "kernels").glob("*integrate_kernel*.nbc"))
+    assert len(loops) == 2
+    a, b = (p.read_bytes() for p in loops)
+    loops[0].write_bytes(b)
+    loops[1].write_bytes(a)
+    assert run() == first
