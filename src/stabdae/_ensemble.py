@@ -24,7 +24,7 @@ from . import _validate as check
 from ._codes import Status
 from ._ensemble_dataset import _ensemble_dataset, _warn_stopped
 from ._model import Model
-from ._raised import first_raising_member, model_raised
+from ._raised import first_raising_member, model_raised, stage_finder
 from .engine.crash import guarded
 from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
@@ -561,7 +561,7 @@ def _raised_in(run: _RunSpec, who: str, exc: BaseException, x0):
     there."""
     if isinstance(exc, MemoryError) or type(exc).__module__.split(".")[0] == "stabdae":
         return exc  # the library's own error, already clear
-    where = None
+    where = find = None
     if not run.adaptive:
         g = run.mode.grid
         kernel = integrator_for(run.model, run.bound)
@@ -580,7 +580,8 @@ def _raised_in(run: _RunSpec, who: str, exc: BaseException, x0):
                                      run.model.n_residual)  # fmt: skip
         if where is not None:
             where = (*where[:2], label.format(where[2]))
-    return model_raised(who, run.model, run.p, exc, where)
+        find = stage_finder(run.model, run.bound, "ldl", run.scheme, g.tau, run.p)
+    return model_raised(who, run.model, run.p, exc, where, find)
 
 
 def default_divergence(epsilon, high, R, steps) -> float:

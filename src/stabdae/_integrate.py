@@ -12,7 +12,7 @@ from . import _validate as check
 from . import theory
 from ._codes import Status
 from ._model import Model
-from ._raised import model_raised, replay_fixed
+from ._raised import model_raised, replay_fixed, stage_finder
 from ._schema import trajectory_dataset
 from .engine.crash import guarded
 from .engine.rk.steps import integrator_for, multipliers_for
@@ -127,7 +127,8 @@ def integrate(
         status, done = run(x0, t0, nsteps, save_every, out_x, out_g, out_e)
     except Exception as exc:  # a model function raised: say which, when and where
         where = replay_fixed(run, x0, t0, tau, nsteps, save_every, out_x, model.n_residual)
-        raise model_raised(who, model, p, exc, where) from exc
+        find = stage_finder(model, bound, multiplier, scheme, tau, p)
+        raise model_raised(who, model, p, exc, where, find) from exc
     status = Status(status)
     if status == Status.OK:  # a trajectory that ran to the end, but far off its manifold
         norms = np.abs(out_g).max(axis=1)

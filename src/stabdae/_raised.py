@@ -13,7 +13,8 @@ import numpy as np
 
 from ._model import _PIECES, ModelError, _call_signature
 
-__all__ = ["first_raising_member", "model_raised", "replay_fixed", "which_function"]
+__all__ = ["first_raising_member", "model_raised", "replay_fixed", "stage_finder",
+           "which_function"]
 
 
 def _vector(x) -> str:
@@ -77,10 +78,37 @@ def first_raising_member(run, x0s, t0: float, tau: float, nsteps: int, ng: int):
     return None
 
 
-def model_raised(who: str, model, p, exc: BaseException, where) -> ModelError:
+def stage_finder(model, bound, multiplier: str, scheme, tau: float, p):
+    """``find(t, x)``: ``(i, t_i, x_i)`` of the first stage whose evaluation raises in the
+    fixed step of size ``tau`` from ``(t, x)`` (None when none does).  It runs the compiled
+    step with the first ``j`` stages of the tableau for ``j = 1, 2, …``: the same
+    arithmetic as the full step up to stage ``j``, whose argument is left in the scratch
+    ``xs`` when it raises."""
+    from .engine.rhs import kernels_for
+    from .engine.rk.steps import stepper_for
+
+    def find(t, x):
+        step = stepper_for(model, bound, multiplier).step
+        ws = kernels_for(model, bound, multiplier).make_workspace()
+        A, b, c = scheme.A, scheme.b, scheme.c
+        for j in range(1, b.size + 1):
+            xs = np.zeros(x.size)
+            try:
+                step(np.array(x, dtype=float), float(t), float(tau), p, bound.matrix,
+                     bound.scalars, np.ascontiguousarray(A[:j, :j]), b[:j].copy(),
+                     c[:j].copy(), ws, np.zeros((j, x.size)), xs)  # fmt: skip
+            except Exception:
+                return j - 1, float(t + c[j - 1] * tau), xs
+        return None
+
+    return find
+
+
+def model_raised(who: str, model, p, exc: BaseException, where, find_stage=None) -> ModelError:
     """The error to raise for ``exc`` from a kernel: ``where`` is ``(t, x)`` of the step it
     started from (None where the replay could not find it), or ``(t, x, whose)`` with
-    ``whose`` naming the trajectory ("member 3")."""
+    ``whose`` naming the trajectory ("member 3"); ``find_stage`` (:func:`stage_finder`)
+    looks inside the step where no function raises at its start."""
     what = f"{type(exc).__name__}: {exc}"
     if where is None:
         return ModelError(f"{who}: a function of model {model.name!r} raised {what} inside "
@@ -94,6 +122,15 @@ def model_raised(who: str, model, p, exc: BaseException, where) -> ModelError:
         piece, raised = found
         return ModelError(f"{who}: {model.name}'s {_call_signature(piece)} raised "
                           f"{type(raised).__name__}: {raised} at {state}{whose}")
+    stage = find_stage(t, np.asarray(x, dtype=float)) if find_stage is not None else None
+    found = None if stage is None else which_function(model, stage[1], stage[2], p)
+    if found is not None:
+        piece, raised = found
+        i, t_i, x_i = stage
+        return ModelError(f"{who}: {model.name}'s {_call_signature(piece)} raised "
+                          f"{type(raised).__name__}: {raised} at t = {t_i:g}, "
+                          f"q = {_vector(x_i[:n])}, v = {_vector(x_i[n:])}: stage {i + 1} "
+                          f"of the step from {state}{whose}")
     return ModelError(f"{who}: a function of model {model.name!r} raised {what} during the "
                       f"step from {state}{whose}, at one of its stages (every function runs "
                       "at that state itself)")

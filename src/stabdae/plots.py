@@ -281,7 +281,12 @@ def plot_dataset(dataset, output=None) -> list[Path]:
         src = Path(dataset)
         if not src.is_file():
             raise FileNotFoundError(f"stabdae plot: no such dataset: {src}")
-        ds = xr.open_dataset(src).load()
+        try:
+            ds = xr.open_dataset(src).load()
+        except (ValueError, OSError) as exc:  # not NetCDF: xarray names its backends instead
+            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise ValueError(f"stabdae plot: {src} is not a NetCDF dataset that xarray can "
+                             f"open ({first})") from None  # fmt: skip
     if "fraction_bounded" not in ds and "tau_star" not in ds:
         raise ValueError("stabdae plot: the dataset has no fraction_bounded or tau_star; it "
                          "is not an ensemble, boundary or study dataset")  # fmt: skip

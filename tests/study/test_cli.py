@@ -191,3 +191,14 @@ def test_plot_refuses_an_older_dataset_in_one_line(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     write_netcdf(ds, tmp_path / "new.nc")
     assert main(["plot", str(tmp_path / "new.nc")]) == 0
+
+
+def test_plot_of_a_file_that_is_not_netcdf_says_so_in_one_line(tmp_path, capsys):
+    """A study file given to ``stabdae plot`` by mistake: one line that names the file and
+    says it is not a NetCDF dataset (before: xarray's three lines about IO backends)."""
+    study = tmp_path / "study.toml"
+    study.write_text("[model]\nfile = 'pendulum'\n")
+    assert main(["plot", str(study)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert f"{study} is not a NetCDF dataset" in err
