@@ -612,7 +612,8 @@ def study_interrupted_then_resumed_is_bit_identical(ctx):
     assert code == 0, err2[-2000:]
     import xarray as xr
 
-    with xr.open_dataset(clean.parent / "out.nc") as a, xr.open_dataset(path.parent / "out.nc") as b:
+    with (xr.open_dataset(clean.parent / "out.nc") as a,
+          xr.open_dataset(path.parent / "out.nc") as b):
         for name in a.data_vars:
             if a[name].dtype.kind in "fiu":
                 np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
@@ -691,7 +692,7 @@ def cache_folder_is_a_file(ctx):
     assert out.returncode == 0, out.stderr[-2000:]
     said = [line for line in out.stderr.splitlines() if "stabdae:" in line and "cache" in line]
     if said:
-        warnings.warn("cache: " + said[0][said[0].index("stabdae:"):])
+        warnings.warn("cache: " + said[0][said[0].index("stabdae:"):], stacklevel=1)
 
 
 @case("ok", "cache")

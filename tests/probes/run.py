@@ -79,8 +79,9 @@ def worker(names: list[str], tmp: str) -> None:
         expect, who, fn = table[name]
         start = time.perf_counter()
         outcome, what = classify(expect, who, fn, ctx)
-        print(json.dumps({"case": name, "outcome": outcome, "what": what,
-                          "seconds": round(time.perf_counter() - start, 2)}), flush=True)  # fmt: skip
+        seconds = round(time.perf_counter() - start, 2)
+        print(json.dumps({"case": name, "outcome": outcome, "what": what, "seconds": seconds}),
+              flush=True)  # fmt: skip
 
 
 def main() -> int:
