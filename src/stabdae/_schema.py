@@ -17,11 +17,14 @@ its ``history`` for every later action, with times in one format (:func:`utc_now
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import os
 import re
 import shutil
+import signal
 import tempfile
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -551,7 +554,36 @@ def write_netcdf(ds: xr.Dataset, path, *, compress: int = 4, overwrite: bool = T
 
     A reader never sees a half-written file, and a failure leaves any previous file intact.
     Floating-point and integer variables are zlib-compressed at level ``compress``.
+    Ctrl-C during the write takes effect once it is done (:func:`deferred_interrupt`).
     """
+    with deferred_interrupt():
+        return _write_netcdf(ds, path, compress, overwrite)
+
+
+@contextlib.contextmanager
+def deferred_interrupt():
+    """Ctrl-C (SIGINT) while the body runs raises ``KeyboardInterrupt`` when it ends, not
+    inside it: neither the HDF5 library nor xarray's file locks survive an interrupt in
+    the middle of a write (one left xarray's lock held, and the clean-up of the
+    interrupted write waited on it forever).  Only in the main thread, where Python runs
+    signal handlers; elsewhere the body runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if caught:
+            if callable(previous):
+                previous(signal.SIGINT, None)  # Python's own handler raises KeyboardInterrupt
+            elif previous == signal.SIG_DFL:
+                raise KeyboardInterrupt
+
+
+def _write_netcdf(ds, path, compress, overwrite) -> Path:
     path = Path(path)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")

@@ -468,3 +468,25 @@ def test_progress_counts_every_member_of_every_point(capsys):
         quiet.close()
         assert quiet._bar is None
     assert capsys.readouterr().err == ""
+
+
+def test_ctrl_c_during_a_write_takes_effect_once_the_file_is_written(tmp_path, monkeypatch):
+    """SIGINT arriving while a dataset (a study's part, its final file) is being written:
+    the file is finished, then KeyboardInterrupt is raised.  Interrupted inside the write,
+    xarray's file lock was left held and the interrupted write's clean-up waited on it
+    forever (a study that did not stop on Ctrl-C); here the old code lost the file."""
+    ds = xr.Dataset({"a": ("x", np.arange(5.0))})
+    real = xr.Dataset.to_netcdf
+
+    def interrupted(self, *args, **kwargs):
+        out = real(self, *args, **kwargs)
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)  # Python runs a signal's handler at the next bytecode boundary
+        return out
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_netcdf(ds, tmp_path / "a.nc")
+    with xr.open_dataset(tmp_path / "a.nc") as back:
+        xr.testing.assert_identical(back.load(), ds)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
