@@ -7,12 +7,15 @@ import hashlib
 import importlib.util
 import keyword
 import sys
+import traceback
 import types
 from pathlib import Path
 
+from ._laws import LawError
 from ._model import Model, ModelError
+from ._schemes import SchemeError
 
-__all__ = ["file_sha256", "load_model", "local_imports", "model_file", "module_name",
+__all__ = ["file_error", "file_sha256", "load_model", "local_imports", "model_file", "module_name",
            "scene_names", "scene_dir"]
 
 
@@ -144,10 +147,12 @@ def load_model(source, attribute: str = "model") -> Model:
         sys.modules[name] = module
         try:
             spec.loader.exec_module(module)
-        except (SyntaxError, ImportError) as exc:  # the file's own error, in one line
+        except (ModelError, LawError, SchemeError):  # stabdae's own, already clear
             del sys.modules[name]
-            where = f"{path}:{exc.lineno}" if getattr(exc, "lineno", None) else str(path)
-            raise ModelError(f"load_model: {where}: {type(exc).__name__}: {exc}") from exc
+            raise
+        except Exception as exc:  # the file's own error, in one line with its place
+            del sys.modules[name]
+            raise ModelError(f"load_model: {file_error(path, exc)}") from exc
         except BaseException:
             del sys.modules[name]
             raise
@@ -214,3 +219,20 @@ def file_sha256(path) -> str:
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+def file_error(path: Path, exc: BaseException) -> str:
+    """``path:line: Type: message`` for an exception raised while running a user's file:
+    the line is the innermost of the traceback that lies in the file (a syntax error's
+    own), so that a mistake anywhere in it is named in one line."""
+    line = getattr(exc, "lineno", None) if isinstance(exc, SyntaxError) else None
+    if line is None:
+        target = Path(path).resolve()
+        for frame in traceback.extract_tb(exc.__traceback__):
+            try:
+                if Path(frame.filename).resolve() == target:
+                    line = frame.lineno
+            except OSError:
+                continue
+    where = f"{path}:{line}" if line else str(path)
+    return f"{where}: {type(exc).__name__}: {exc}"

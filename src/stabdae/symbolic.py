@@ -679,7 +679,14 @@ def load_spec(path: str | Path) -> System:
     path = Path(path)
     if not path.is_file():
         raise SymbolicError(f"generate: no such spec file: {path}")
-    namespace = runpy.run_path(str(path), run_name=f"stabdae_spec_{path.stem}")
+    try:
+        namespace = runpy.run_path(str(path), run_name=f"stabdae_spec_{path.stem}")
+    except SymbolicError:
+        raise
+    except Exception as exc:  # the spec's own error, in one line with its place
+        from ._loading import file_error
+
+        raise SymbolicError(f"generate: {file_error(path, exc)}") from exc
     found = {k: v for k, v in namespace.items() if isinstance(v, System)}
     if "system" in found:
         return found["system"]

@@ -233,3 +233,29 @@ def test_cli_generate_bad_spec(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "must define one stabdae.symbolic.System" in err
     assert not (tmp_path / "m.py").exists()
+
+
+@pytest.mark.parametrize("text, line, what", [
+    ("import sympy as sp\nq = sp.symbols('q'\n", 2, "SyntaxError"),
+    ("import sympy as sp\n\nx = undefined_name + 1\n", 3, "NameError: name 'undefined_name'"),
+])  # fmt: skip
+def test_cli_generate_names_the_spec_files_own_error_and_line(tmp_path, capsys, text, line,
+                                                             what):  # fmt: skip
+    """A mistake in the spec file: one line with the file, the line and the error (before:
+    a traceback and exit 1)."""
+    spec = tmp_path / "broken.py"
+    spec.write_text(text)
+    assert main(["generate", str(spec), "-o", str(tmp_path / "m.py")]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and err.count("\n") == 1, err
+    assert f"generate: {spec}:{line}: {what}" in err, err
+
+
+def test_load_model_names_the_model_files_own_error_and_line(tmp_path):
+    """A model file that fails when run (a NameError in its third line): load_model says
+    where, in one line, as it does for a syntax error."""
+    path = tmp_path / "broken_model.py"
+    path.write_text("import numpy as np\n\nM = np.eye(2) * undefined_mass\n")
+    with pytest.raises(stabdae.ModelError) as info:
+        stabdae.load_model(path)
+    assert str(info.value).startswith(f"load_model: {path}:3: NameError: name 'undefined_mass'")

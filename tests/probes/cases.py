@@ -373,7 +373,8 @@ for _label, _kw in [
     ("rtol_zero", dict(tau=(0.01, 0.5), rtol=0.0)),
     ("q_above_one", dict(tau=(0.01, 0.5), q=1.5)),
     ("search_members_zero", dict(tau=(0.01, 0.5), search_members=0)),
-    ("adaptive_scheme", dict(tau=(0.01, 0.5), scheme="dopri5")),
+    ("members_zero", dict(tau=(0.01, 0.5), members=0)),
+    ("bracket_nan", dict(tau=(float("nan"), 0.5))),
 ]:
     def _fn(ctx, kw=_kw):
         args = dict(members=16, search_members=8, steps=100)
@@ -716,3 +717,95 @@ def cache_entries_swapped_are_recompiled(ctx):
     loops[0].write_bytes(b)
     loops[1].write_bytes(a)
     assert run() == first
+
+
+# ------------------------------------------------------------ more faults and commands
+@case("ok", "stabdae run")
+def study_killed_hard_then_resumed_is_bit_identical(ctx):
+    """SIGKILL (no clean-up at all) part-way, then the same command: the finished points
+    are kept, the rest computed, and the dataset is that of a clean run."""
+    body = _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [1e-3, 2e-3, 4e-3, 8e-3]")
+    body = _replace(body, "t_end = 0.2", "t_end = 2.0")
+    clean = ctx.study("clean_kill", body)
+    code, _, err = ctx.cli("run", clean, cwd=clean.parent)
+    assert code == 0, err[-2000:]
+    path = ctx.study("killed", body)
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src))
+    proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)], cwd=path.parent,
+                            env=environ, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parts = path.parent / "out.nc.parts"
+    deadline = time.time() + 300
+    while time.time() < deadline and len(list(parts.glob("*.nc"))) < 1:
+        time.sleep(0.05)
+    proc.kill()
+    proc.wait()
+    code, _, err = ctx.cli("run", path, cwd=path.parent)
+    assert code == 0, err[-2000:]
+    import xarray as xr
+
+    with (xr.open_dataset(clean.parent / "out.nc") as a,
+          xr.open_dataset(path.parent / "out.nc") as b):
+        for name in a.data_vars:
+            if a[name].dtype.kind in "fiu":
+                np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+
+
+@case("ok", "stabdae run")
+def study_output_in_a_folder_not_yet_made(ctx):
+    path = ctx.study("newfolder", _replace(PENDULUM_STUDY, 'path = "out.nc"',
+                                           'path = "a/b/out.nc"'))  # fmt: skip
+    code, _, err = ctx.cli("run", path, "--no-plots", cwd=path.parent)
+    assert code == 0, err[-2000:]
+    assert (path.parent / "a" / "b" / "out.nc").exists()
+
+
+@case("ok", "stabdae theory")
+def cli_theory_of_a_study(ctx):
+    path = ctx.study("theory", PENDULUM_STUDY)
+    code, out, err = ctx.cli("theory", path, cwd=path.parent)
+    assert code == 0, err[-2000:]
+
+
+@case("error", "stabdae check")
+def cli_check_finds_a_sign_error_in_f_accel(ctx):
+    path = ctx.model_file("signerror", _model_text(replace={
+        "out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])":
+        "out[0] = -2.0 * (v[0] * v[0] + v[1] * v[1])"}))  # fmt: skip
+    code, out, err = ctx.cli("check", path)
+    assert code != 0, out[-2000:]
+    assert "f_accel" in out + err
+    raise CliError(2, "stabdae check: f_accel DISAGREES (exit "
+                   f"{code})")
+
+
+@case("error", "stabdae generate")
+def cli_generate_spec_with_a_syntax_error(ctx):
+    spec = ctx.tmp / "bad_spec.py"
+    spec.write_text("import sympy as sp\nq = sp.symbols('q'\n")
+    code, out, err = ctx.cli("generate", spec)
+    return _cli_outcome(code, out, err, "generate", None, ctx, spec)
+
+
+@case("ok", "stabdae integrate")
+def cli_integrate_a_tableau_of_forty_stages(ctx):
+    s = 40
+    A = np.tril(np.full((s, s), 0.5 / s), -1)
+    b = np.full(s, 1.0 / s)
+    tableau = {"A": A.tolist(), "b": b.tolist(), "c": A.sum(1).tolist(), "order": 1,
+               "name": "forty"}  # fmt: skip
+    from stabdae._schemes import tableau_order
+
+    tableau["order"] = tableau_order(A, b)
+    code, out, err = ctx.cli("integrate", "pendulum", "--tableau", json.dumps(tableau),
+                             "--t-end", "0.1", timeout=600)  # fmt: skip
+    assert code == 0, err[-2000:]
+
+
+@case("ok", "stabdae plot")
+def cli_plot_an_ensemble_dataset(ctx):
+    from stabdae._schema import write_netcdf
+
+    ds = ctx.stabdae.ensemble(ctx.pendulum(), ctx.law(), "midpoint", 0.01, 0.5, members=16)
+    path = write_netcdf(ds, ctx.tmp / "ens.nc")
+    code, out, err = ctx.cli("plot", path)
+    assert code == 0, err[-2000:]
