@@ -117,7 +117,8 @@ def boundary(
     Returns
     -------
     xarray.Dataset
-        ``tau_star`` (the bracket's geometric mean) with ``tau_star_low`` (stable, with
+        ``tau_star`` (the bracket's geometric mean; for a constant law with the spectral
+        limit as the bracket's top where it lies inside) with ``tau_star_low`` (stable, with
         the full ensemble) and ``tau_star_high`` (not stable), ``tau_star_reason``; the
         full ensemble's ``fraction_stable`` at ``tau_star_low`` with its Wilson interval
         and ``members_run``/``members_stable``; every probe (``probe_tau``,
@@ -248,7 +249,11 @@ def boundary(
                 if not decided:
                     reason = PROBE_UNDECIDED
 
-    star = math.sqrt(good * bad) if reason == BRACKETED else math.nan
+    # a constant law is stable at no τ past the spectral limit: the bracket's top is the
+    # limit where it lies inside, so τ* (the bracket's geometric mean) never lies beyond it
+    top = min(bad, limits["tau_limit_spectral"]) if good <= limits["tau_limit_spectral"] \
+        else bad  # fmt: skip
+    star = math.sqrt(good * top) if reason == BRACKETED else math.nan
     at = _last(probes, good, members)
     floor = (floor_limit(model, law, scheme, epsilon, steps=steps if t_end is None else None,
                          t_end=t_end, params=p, rtol=rtol,
