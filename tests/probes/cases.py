@@ -573,7 +573,9 @@ _study_case("valid", PENDULUM_STUDY, expect="ok", check=_runs_and_writes)
 
 @case("error", "stabdae run")
 def study_second_run_on_the_same_output_while_one_runs(ctx):
-    body = _replace(PENDULUM_STUDY, "t_end = 0.2", "t_end = 20.0")
+    body = _replace(PENDULUM_STUDY, "t_end = 0.2", "t_end = 200.0")
+    body = _replace(body, "members = 16", "members = 4096")
+    body = _replace(body, "tau = [1e-3, 2e-3]", "tau = [1e-3, 1.1e-3, 1.2e-3, 1.3e-3]")
     path = ctx.study("concurrent", body)
     environ = dict(os.environ, PYTHONPATH=str(ctx.src))
     first = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)],
@@ -582,9 +584,13 @@ def study_second_run_on_the_same_output_while_one_runs(ctx):
     try:
         parts = path.parent / "out.nc.parts"
         deadline = time.time() + 300
-        while not parts.exists() and time.time() < deadline:
+        while not (parts / "lock").exists() and time.time() < deadline:
             time.sleep(0.2)
-        code, out, err = ctx.cli("run", path, cwd=path.parent)
+        code, out, err = ctx.cli("run", path, "--force", cwd=path.parent)
+        if first.poll() is not None:
+            raise AssertionError("the first run ended before the second started: "
+                                 + first.communicate()[1][-1500:])
+        assert "another stabdae run" in err, err[-2000:]
     finally:
         first.send_signal(signal.SIGINT)
         first.communicate(timeout=300)
