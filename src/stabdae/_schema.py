@@ -583,8 +583,23 @@ def deferred_interrupt():
                 raise KeyboardInterrupt
 
 
+def _cf_encoded(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` as CF wants it on disk (a shallow copy): a code variable's ``flag_values`` of
+    the variable's own type (CF 3.5), and no ``_FillValue`` on coordinate variables (CF
+    2.5.1: a coordinate has no missing values)."""
+    ds = ds.copy(deep=False)
+    for name, var in ds.variables.items():
+        if "flag_values" in var.attrs and var.dtype.kind in "iu":
+            var.attrs = {**var.attrs,
+                         "flag_values": np.asarray(var.attrs["flag_values"], dtype=var.dtype)}
+        if name in ds.coords and var.dtype.kind in "fiu":
+            var.encoding = {**var.encoding, "_FillValue": None}
+    return ds
+
+
 def _write_netcdf(ds, path, compress, overwrite) -> Path:
     path = Path(path)
+    ds = _cf_encoded(ds)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -199,3 +199,34 @@ def test_write_netcdf_compresses_the_numeric_arrays_at_the_level_asked(tmp_path)
             assert not nc[name].filters()["zlib"], name
     back = xr.open_dataset(path).load()
     xr.testing.assert_identical(back.drop_attrs(), ds.drop_attrs())
+
+
+def test_files_carry_cf_flags_and_coordinates(tmp_path):
+    """On disk, as CF 1.10 and its compliance checker want: a code variable's
+    ``flag_values`` have the variable's own type (CF 3.5; they were int64 beside int8
+    codes), and no coordinate variable has a ``_FillValue`` (CF 2.5.1).  Read with
+    netCDF4 itself, not through xarray, which hides both."""
+    import netCDF4
+    import numpy as np
+
+    from stabdae._schema import write_netcdf
+
+    model = pendulum_scene()
+    law = stabdae.baumgarte(10.0)
+    datasets = {
+        "trajectory": stabdae.integrate(model, None, law, "rk4", 1e-3, 0.1, 0.01),
+        "ensemble": stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=8, save_dt=0.01),
+    }
+    for kind, ds in datasets.items():
+        path = write_netcdf(ds, tmp_path / f"{kind}.nc")
+        with netCDF4.Dataset(path) as nc:
+            flagged = [v for v in nc.variables.values() if "flag_values" in v.ncattrs()]
+            assert flagged or kind == "trajectory"
+            for var in flagged:
+                assert np.asarray(var.flag_values).dtype == var.dtype, (kind, var.name)
+            coords = [v for name, v in nc.variables.items() if v.dimensions == (name,)]
+            assert coords, kind
+            for var in coords:
+                assert "_FillValue" not in var.ncattrs(), (kind, var.name)
+    # in memory as before: the plain list (a shallow copy was written)
+    assert datasets["ensemble"].status.attrs["flag_values"] == [int(c) for c in stabdae.Status]
