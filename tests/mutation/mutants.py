@@ -730,7 +730,8 @@ MUTANTS = [
            "a kernel cache entry is loaded without checking its key and checksum"),
     Mutant("interrupt-not-deferred",
            S + "_schema.py",
-           "    with deferred_interrupt():\n        return _write_netcdf(ds, path, compress, overwrite)",
+           "    with deferred_interrupt():\n"
+           "        return _write_netcdf(ds, path, compress, overwrite)",
            "    return _write_netcdf(ds, path, compress, overwrite)",
            ('tests/study/test_run.py::test_ctrl_c_during_a_write_takes_effect_once_the_file_is_written',),
            "Ctrl-C interrupts a NetCDF write in the middle"),

@@ -483,3 +483,36 @@ def test_summary_names_unstable_members_where_the_law_is_stable():
         "beyond the law's bound)"]
     calm = ds.isel({"run.tau": [0, 2]})
     assert "linear part is stable" not in summary(calm)
+
+
+def test_a_search_studys_progress_moves_with_its_probes(tmp_path):
+    """A boundary search's grid point is counted in the members of the probes it is
+    expected to run (the bracket's ends, two beside the spectral limit, the bisection to
+    rtol, the confirmation); each probe's line moves the bar by its members, never past
+    the point's share until the point is done (before: the bar stood still through a
+    point and jumped by the confirmation's members at its end, and its time left was
+    the rest of the run at that pace).  The probe lines are stabdae.boundary's own."""
+    import math
+
+    from stabdae.study.run import _Progress, _work_per_point
+
+    pytest.importorskip("tqdm")
+    study = load_study(write(tmp_path, SEARCH))
+    halvings = math.ceil(math.log2(math.log(3.0 / 1e-3) / math.log(1.05)))
+    work = _work_per_point(study)
+    assert work == (4 + halvings) * 8 + 16
+    lines = []
+    stabdae.boundary(study.model, stabdae.baumgarte(10.0, 1.0), "rk4", tau=(1e-3, 3.0),
+                     rtol=0.05, members=16, search_members=8, steps=200, progress=lines.append)
+    assert lines
+    bar = _Progress(2, 0, work, True)
+    seen = []
+    for line in lines:
+        bar.note(line)
+        seen.append(bar._bar.n)
+    assert seen[0] == 8 and seen == sorted(seen) and seen[-1] <= work - 1
+    bar.point_done()
+    assert bar._bar.n == work
+    bar.note(lines[0])
+    assert bar._bar.n == work + 8
+    bar.close()

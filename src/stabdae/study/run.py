@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
+import re
 import socket
 import sys
 import time
@@ -327,7 +329,7 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
     if len(todo) < len(points):
         log(f"resuming: {len(points) - len(todo)} of {len(points)} grid points already done")
     start = time.perf_counter()
-    bar = _Progress(len(points), len(points) - len(todo), study.ensemble["members"], progress)
+    bar = _Progress(len(points), len(points) - len(todo), _work_per_point(study), progress)
     try:
         if workers or scheduler:
             _run_dask(study, todo, manifest, workers, scheduler, bar)
@@ -440,9 +442,25 @@ def combine(study: Study, parts: Path, npoints: int) -> xr.Dataset:
     return ds
 
 
+def _work_per_point(study: Study) -> int:
+    """A grid point's work in member runs: its ensemble's members, or for a boundary
+    search the members of the probes it is expected to run (the bracket's ends, two
+    beside the spectral limit, the bisection from the whole bracket down to ``rtol``,
+    each of ``search_members``, and the full ensemble's confirmation), so that the bar
+    moves, and its time left is estimated, per probe (:meth:`_Progress.note`)."""
+    members = int(study.ensemble["members"])
+    if study.search is None:
+        return members
+    s = study.search
+    lo, hi = s["tau"]
+    halvings = math.ceil(math.log2(max(math.log(hi / lo) / math.log1p(s["rtol"]), 1.0)))
+    return (4 + halvings) * int(s["search_members"]) + members
+
+
 class _Progress:
-    """A progress bar over grid points and members (tqdm when installed, else a line on
-    stderr per point); silent when ``enabled`` is false."""
+    """A progress bar over grid points and their work in member runs
+    (:func:`_work_per_point`; tqdm when installed, else a line on stderr per point);
+    silent when ``enabled`` is false."""
 
     def __init__(self, points: int, done: int, members: int, enabled: bool):
         self.points, self.done, self.members_total = points, done, members
@@ -474,9 +492,13 @@ class _Progress:
             self._last = done
 
     def note(self, text: str):
-        """A line from a boundary search (each probe)."""
+        """A line from a boundary search (each probe): its members count on the bar, up
+        to the point's share less one (the rest when the point is done)."""
         if self._compiling:
             self.members(0, self.members_total)
+        run = re.search(r" of (\d+) members", text)
+        if run is not None:
+            self.members(min(self._last + int(run.group(1)), self.members_total - 1), 0)
         if self._bar is not None:
             self._bar.set_postfix_str(text.removeprefix("boundary: "), refresh=False)
         elif self.enabled:
