@@ -30,7 +30,7 @@ def integrate_adaptive(
     *,
     scheme="dopri5",
     rtol: float = 1e-8,
-    atol: float = 1e-10,
+    atol=1e-10,
     save_dt: float | None = None,
     first_step: float | None = None,
     max_steps: int = 10_000_000,
@@ -57,8 +57,13 @@ def integrate_adaptive(
         Hairer's DOP853 (order 8 with fifth- and third-order error estimates, 12 stages and
         one more evaluation at the new state, reused as the next step's first), cheaper
         per digit at tight tolerances.
-    rtol, atol : float
-        Relative and absolute local error tolerances (per state component, RMS norm).
+    rtol, atol : float, or for ``atol`` array of shape (2n,)
+        Relative and absolute local error tolerances (RMS norm over the state's
+        components of ``error_l / (atol_l + rtol·|x_l|)``); ``atol`` a number, or one per
+        component of ``x = (q, v)`` where their scales differ (as SciPy's ``solve_ivp``
+        takes it): a component near zero needs an ``atol`` below its own scale, and one
+        number small enough for the smallest component makes every other one take steps
+        it does not need.
     save_dt : float, optional
         Spacing of the stored samples (the last one at ``t_end``); steps end exactly on
         them.  Default: only ``t0`` and ``t_end``.
@@ -94,7 +99,7 @@ def integrate_adaptive(
     who = "integrate_adaptive"
     model = check.model(model, who)
     law = check.law(law, who, "stabdae.none() or stabdae.baumgarte(omega=10.0, xi=1.0)")
-    rtol, atol = check.tolerances(rtol, atol, who)
+    rtol, atol, atol_given = check.tolerances(rtol, atol, who, 2 * model.n)
     p = check.params(model, params, who)
     t0 = model.t0 if t0 is None else check.real(t0, "t0", who)
     check.span(t0, t_end, who)
@@ -131,7 +136,7 @@ def integrate_adaptive(
     times = np.concatenate([[t0], save_times])
     ds = trajectory_dataset(
         model, p, law, scheme, times, out_x, out_g, out_e, status, int(counts[0]),
-        dict(method=pair.name, rtol=rtol, atol=atol, t0=t0, t_end=float(t_end),
+        dict(method=pair.name, rtol=rtol, atol=atol_given, t0=t0, t_end=float(t_end),
              steps=int(counts[0]), multiplier=multiplier,
              projection=str(projection).lower()),
         action="integrate_adaptive",

@@ -207,7 +207,8 @@ def ensemble(
     rtol, atol : float, optional
         Adaptive steps: each member controls its own step with the scheme's embedded pair
         (Dormand–Prince 5(4) by default, or DOP853; as :func:`integrate_adaptive`) to
-        these tolerances (``atol`` defaults to ``rtol``).  The dataset then also has
+        these tolerances (``atol`` defaults to ``rtol``; a number, or one per state
+        component, shape ``(2n,)``).  The dataset then also has
         ``steps_accepted`` and ``rhs_evaluations`` per member, and only the
         continuous-time prediction ``beta_theory``.
     members : int
@@ -389,7 +390,9 @@ class _Lanes:
 
     def attrs(self, run) -> dict:
         g = self.grid
-        return dict(method=f"{self.name}-adaptive", rtol=g.rtol, atol=g.atol, first_step=g.h0,
+        # one number where every component has the same (as it was given, or alike)
+        atol = float(g.atol[0]) if (g.atol == g.atol[0]).all() else g.atol
+        return dict(method=f"{self.name}-adaptive", rtol=g.rtol, atol=atol, first_step=g.h0,
                     t0=g.t0, t_end=run.t_end, save_dt=run.save_dt)  # fmt: skip
 
     def extra(self, out) -> dict:
@@ -493,7 +496,8 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
     if adaptive:
         pair = check.pair(None if scheme is None else check.scheme(scheme, who), who)
         scheme = pair.scheme
-        rtol, atol = check.tolerances(rtol, rtol if atol is None else atol, who)
+        rtol, atol, _ = check.tolerances(rtol, rtol if atol is None else atol, who,
+                                         2 * model.n)  # fmt: skip
     elif atol is not None:
         raise ValueError(f"{who}: atol is for adaptive steps; give rtol as well")
     scheme = check.scheme(scheme, who, default="rk2")

@@ -110,18 +110,34 @@ def positive(value, name: str, who: str) -> float:
     return out
 
 
-def tolerances(rtol, atol, who: str) -> tuple[float, float]:
-    """The adaptive steps' ``(rtol, atol)``, one rule for every caller: both positive and
-    finite, ``rtol`` at least 100 machine epsilons (below it the error estimate is
-    roundoff, and the step size would shrink without end)."""
+def tolerances(rtol, atol, who: str, size: int):
+    """The adaptive steps' ``(rtol, atol, as_given)``, one rule for every caller: ``rtol``
+    positive and finite and at least 100 machine epsilons (below it the error estimate is
+    roundoff, and the step size would shrink without end); ``atol`` a positive finite
+    number or one per state component (shape ``(size,)`` = (2n,), as SciPy's
+    ``solve_ivp`` takes it), returned as an array of ``size`` either way, and as given
+    (a float, or the array) for the dataset."""
     rtol = positive(rtol, "rtol", who)
-    atol = positive(atol, "atol", who)
+    if np.ndim(atol) == 0:
+        given = positive(atol, "atol", who)
+        vector = np.full(size, given)
+    else:
+        vector = _real_array(atol, who, "atol")
+        if vector.shape != (size,):
+            raise ValueError(f"{who}: atol must be a number or one per state component, "
+                             f"shape (2n,) = ({size},); got shape {vector.shape}")
+        bad = np.flatnonzero(~(np.isfinite(vector) & (vector > 0)))
+        if bad.size:
+            raise ValueError(f"{who}: atol must be positive and finite in every component; "
+                             f"components {bad.tolist()} are {vector[bad].tolist()}")
+        given = vector.copy()
+    atol = vector
     if rtol < 100 * np.finfo(float).eps:
         raise ValueError(
             f"{who}: rtol = {rtol:g} is below 100 machine epsilons "
             f"({100 * np.finfo(float).eps:.1e}); the error estimate is roundoff"
         )
-    return rtol, atol
+    return rtol, np.ascontiguousarray(atol), given
 
 
 def count(value, name: str, who: str) -> int:

@@ -63,13 +63,14 @@ class AdaptiveGrid(NamedTuple):
     save_times: np.ndarray
     h0: float
     rtol: float
-    atol: float
+    atol: np.ndarray  #: one per state component
     max_steps: int
 
     @classmethod
     def of(cls, t0, save_times, h0, rtol, atol, max_steps) -> AdaptiveGrid:
         return cls(float(t0), np.ascontiguousarray(save_times, dtype=float), float(h0),
-                   float(rtol), float(atol), np.int64(max_steps))  # fmt: skip
+                   float(rtol), np.ascontiguousarray(atol, dtype=float),
+                   np.int64(max_steps))  # fmt: skip
 
 
 class Tableau(NamedTuple):

@@ -112,11 +112,11 @@ def _adaptive_loop(K, save, label: str):
                 finite = st == 0
             e = 0.0
             if finite:
-                # ‖·‖ over (atol + rtol max(|x|, |x_new|)): the RMS of τ Σ e_i k_i, or for
+                # ‖·‖ over (atol_l + rtol max(|x_l|, |x_new,l|)): the RMS of τ Σ e_i k_i, or for
                 # DOP853 Hairer's ‖e₅‖² / √(‖e₅‖² + 0.01 ‖e₃‖²) from the two estimates
                 s5 = s3 = 0.0
                 for l in range(N2):
-                    sc = atol + rtol * max(abs(x[l]), abs(xnew[l]))
+                    sc = atol[l] + rtol * max(abs(x[l]), abs(xnew[l]))
                     acc5 = 0.0
                     for i in range(s_e):
                         if tab_e[0, i] != 0.0:
@@ -249,7 +249,7 @@ def _attempt_source(s: int, s_e: int, combined: bool, pattern: tuple, n2: int) -
     # the lane loop around a loop left rolled stays scalar.  Each sum still runs over l
     # in order, as the single loop's.
     lines += ["    sc = stack1(N2)"]
-    lines += over_state(["sc[l] = atol + rtol * max(abs(x[l]), abs(xn[l]))"])
+    lines += over_state(["sc[l] = atol[l] + rtol * max(abs(x[l]), abs(xn[l]))"])
     lines += ["    s5 = 0.0"]
     est5 = ["acc5 = 0.0"] + [f"acc5 += tab_e[0, {i}] * k{i}[l]" for i in range(s_e)
                              if e_nz[0][i]]  # fmt: skip

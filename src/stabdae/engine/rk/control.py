@@ -3,7 +3,8 @@
 (:mod:`stabdae.engine.ensemble.lanes`), so that both take the same steps.
 
 Local error control ``err ≤ 1`` per step with the error estimates ``e = τ Σ (b_i − b̂_i) k_i``
-scaled by ``atol + rtol·max(|x|, |x̃|)``: ``err`` is their RMS norm for Dormand–Prince, and
+scaled by ``atol_l + rtol·max(|x_l|, |x̃_l|)`` (``atol`` one per state component): ``err``
+is their RMS norm for Dormand–Prince, and
 ``‖e₅‖² / √(‖e₅‖² + 0.01 ‖e₃‖²)`` of the fifth- and third-order estimates for DOP853 (as in
 Hairer's code and SciPy's).  The step is updated by ``SAFETY · err^{−1/(q+1)}`` within
 ``[MIN_FACTOR, MAX_FACTOR]`` (``q`` = 4 and 7: the estimate's order; no growth right after a
@@ -99,7 +100,7 @@ def _first_step(f_eval, N2: int):
             return h0, 0
         d0 = d1 = 0.0
         for l in range(N2):
-            sc = atol + rtol * abs(x[l])
+            sc = atol[l] + rtol * abs(x[l])
             d0 += (x[l] / sc) ** 2
             d1 += (k0[l] / sc) ** 2
         d0, d1 = math.sqrt(d0 / N2), math.sqrt(d1 / N2)
@@ -111,7 +112,7 @@ def _first_step(f_eval, N2: int):
         if st == 0:
             d2 = 0.0
             for l in range(N2):
-                sc = atol + rtol * abs(x[l])
+                sc = atol[l] + rtol * abs(x[l])
                 d2 += ((k1[l] - k0[l]) / sc) ** 2
             d2 = math.sqrt(d2 / N2) / h
             if max(d1, d2) <= 1e-15:
