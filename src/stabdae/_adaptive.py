@@ -15,13 +15,12 @@ from ._codes import Status
 from ._integrate import IntegrationWarning, _multipliers
 from ._model import Model
 from ._schema import trajectory_dataset
-from .engine.crash import guarded
+from .engine.crash import guard
 from .engine.rk.adaptive import adaptive_for
 
 __all__ = ["integrate_adaptive"]
 
 
-@guarded("integrate_adaptive")
 def integrate_adaptive(
     model: Model,
     x0=None,
@@ -119,11 +118,12 @@ def integrate_adaptive(
     out_g = np.full((nsave, model.n_residual), np.nan)
     out_e = np.full(nsave, np.nan)
     counts = np.zeros(3, dtype=np.int64)
-    status, written = kernel(
-        x0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b, pair.error,
-        scheme.c, pair.combined, pair.error_order, rtol, atol, h0, int(max_steps), sweeps,
-        tol, out_x, out_g, out_e, counts,
-    )  # fmt: skip
+    with guard(who):
+        status, written = kernel(
+            x0, t0, save_times, p, bound.matrix, bound.scalars, scheme.A, scheme.b, pair.error,
+            scheme.c, pair.combined, pair.error_order, rtol, atol, h0, int(max_steps), sweeps,
+            tol, out_x, out_g, out_e, counts,
+        )  # fmt: skip
     status = Status(status)
     if status != Status.OK:
         warnings.warn(

@@ -38,7 +38,6 @@ from ._measures import (
     ensemble_verdict,
 )
 from ._schema import provenance, schema_variable, variable
-from .engine.crash import guarded
 from .engine.ensemble.block import BLOCK
 
 __all__ = ["boundary", "floor_limit"]
@@ -56,7 +55,6 @@ MIN_STEPS = 2000
 MAX_CONFIRM = 40
 
 
-@guarded("boundary")
 def boundary(
     model,
     law,

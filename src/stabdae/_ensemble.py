@@ -25,7 +25,7 @@ from ._codes import Status
 from ._ensemble_dataset import _ensemble_dataset, _warn_stopped
 from ._model import Model
 from ._raised import first_raising_member, model_raised, stage_finder
-from .engine.crash import guarded
+from .engine.crash import guard
 from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
 from .engine.ensemble.groups import (
@@ -69,7 +69,6 @@ STRIDE_CHANGE = 0.2
 
 
 # --------------------------------------------------------------------- sampling
-@guarded("sample_perturbations")
 def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0, *,
                          params=None, t0=None, threads=None):  # fmt: skip
     """Initial states ``x⁰`` with prescribed constraint perturbations ``g(x⁰, t0) = α⁰``.
@@ -164,7 +163,6 @@ def _threads(threads, who: str):
 
 
 # --------------------------------------------------------------------- driver
-@guarded("ensemble")
 def ensemble(
     model: Model,
     law,
@@ -414,8 +412,9 @@ class _Lanes:
             out = self._outputs(run, x0, np.zeros(1, dtype=np.int8), rows, cols)
             measure = AdaptiveMeasurement.of(math.inf, run.R, run.h_pred, np.full(1, -1),
                                              np.zeros((0, cols)))  # fmt: skip
-            self.kernel(inputs(x0, np.zeros((1, cols - 1)), run.p, run.bound), self.grid,
-                        self.tableau, measure, out, 0, 1)  # fmt: skip
+            with guard("ensemble"):
+                self.kernel(inputs(x0, np.zeros((1, cols - 1)), run.p, run.bound), self.grid,
+                            self.tableau, measure, out, 0, 1)  # fmt: skip
             need = int(out.steps[0]) + 1
             if out.status[0] != 0 or need * cols > REFERENCE_MAX_ENTRIES:
                 return np.zeros((0, cols))
@@ -643,11 +642,12 @@ def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK,
         kernel = ensemble_kernel_for(model, bound, scheme, block)
     x0 = model.reference_state(p)[None, :]
     out = outputs(1, x0.shape[1], ng, 0, 2, rdtype, residuals=nsteps + 1)
-    kernel(inputs(x0, np.zeros((1, ng)), p, bound), FixedGrid.of(t0, tau, nsteps, nsteps),
-           Tableau.of(scheme),
-           FixedMeasurement.of(math.inf, np.zeros((0, ng)), np.zeros((0, 0)), nsteps + 1,
-                               np.full(1, -1)),
-           out, 0, 1)  # fmt: skip
+    with guard("ensemble"):
+        kernel(inputs(x0, np.zeros((1, ng)), p, bound), FixedGrid.of(t0, tau, nsteps, nsteps),
+               Tableau.of(scheme),
+               FixedMeasurement.of(math.inf, np.zeros((0, ng)), np.zeros((0, 0)), nsteps + 1,
+                                   np.full(1, -1)),
+               out, 0, 1)  # fmt: skip
     if out.status[0] != 0 or not np.isfinite(out.g_out).all():
         return np.zeros((0, ng))
     return out.g_out

@@ -14,7 +14,7 @@ from ._codes import Status
 from ._model import Model
 from ._raised import model_raised, replay_fixed, stage_finder
 from ._schema import trajectory_dataset
-from .engine.crash import guarded
+from .engine.crash import guard
 from .engine.rk.steps import integrator_for, multipliers_for
 
 __all__ = ["integrate", "IntegrationWarning"]
@@ -24,7 +24,6 @@ class IntegrationWarning(RuntimeWarning):
     """An integration stopped early; the dataset holds everything up to that step."""
 
 
-@guarded("integrate")
 def integrate(
     model: Model,
     x0=None,
@@ -124,7 +123,8 @@ def integrate(
                       scheme.A, scheme.b, scheme.c, sweeps, tol, ox, og, oe)  # fmt: skip
 
     try:
-        status, done = run(x0, t0, nsteps, save_every, out_x, out_g, out_e)
+        with guard(who):
+            status, done = run(x0, t0, nsteps, save_every, out_x, out_g, out_e)
     except Exception as exc:  # a model function raised: say which, when and where
         where = replay_fixed(run, x0, t0, tau, nsteps, save_every, out_x, model.n_residual)
         find = stage_finder(model, bound, multiplier, scheme, tau, p)

@@ -23,6 +23,7 @@ one floor up do, once).  By role:
   :mod:`.decay.traces`;
 * :mod:`.sampler` — placing initial states at prescribed constraint perturbations;
 * :mod:`.threads` — running ``nogil`` kernels over chunks of members on a thread pool;
+* :mod:`.crash` — what is printed when a compiled kernel crashes (segmentation fault);
 * :mod:`.cache` — the compile spec (:class:`.cache.Spec`), the per-model memo of the
   compiled closures and their on-disk cache.
 """

@@ -4,7 +4,7 @@ A model function that writes outside its ``out`` array at a state that ``Model()
 ``model.check()`` did not try (they run every function as Python and bounds-checked)
 corrupts memory in a compiled kernel, or makes the process die of a segmentation fault
 with nothing said.  Checking every index in the kernels costs their speed, so the
-default runs unchecked; while a public entry point (:func:`guarded`) runs, a handler of
+default runs unchecked; while a kernel called under :func:`guard` runs, a handler of
 SIGSEGV and SIGBUS writes what happened and what to do to stderr and then hands the
 signal to the handler that was there before (Python's ``faulthandler``, if enabled, then
 prints the Python stack; otherwise the process dies as before).  The process is not
@@ -18,14 +18,14 @@ addresses it writes from are this process's).  Linux only; elsewhere, or with
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
-import functools
 import os
 import signal
 import sys
 import threading
 
-__all__ = ["guarded"]
+__all__ = ["guard"]
 
 _SIGNALS = (signal.SIGSEGV, signal.SIGBUS) if hasattr(signal, "SIGBUS") else (signal.SIGSEGV,)
 #: glibc's struct sigaction is 152 bytes on x86-64 and aarch64: room to spare
@@ -110,34 +110,29 @@ def _restore() -> None:
         c_sigaction(int(sig), ctypes.addressof(_OLD[sig]), 0)
 
 
-def guarded(who: str):
-    """Decorator: while the function runs (outermost call only), a crash in a compiled
-    kernel prints what happened and what to do before the process dies."""
-
-    def wrap(fn):
-        @functools.wraps(fn)
-        def run(*args, **kwargs):
-            entered = False
-            with _LOCK:
-                if _state["depth"] == 0 and not _state["failed"] and _enabled():
-                    try:
-                        _install(who)
-                        entered = True
-                    except Exception:  # no libc, no numba cfunc: run without the message
-                        _state["failed"] = True
-                elif _state["depth"] > 0:
-                    entered = True
-                if entered:
-                    _state["depth"] += 1
+@contextlib.contextmanager
+def guard(who: str):
+    """While the body runs (the outermost guard only), a crash in a compiled kernel
+    prints what happened and what to do before the process dies.  A context manager
+    around the kernel calls, not a decorator of the public functions: a wrapper's frame
+    would shift every warning's ``stacklevel`` off the caller's line."""
+    entered = False
+    with _LOCK:
+        if _state["depth"] == 0 and not _state["failed"] and _enabled():
             try:
-                return fn(*args, **kwargs)
-            finally:
-                if entered:
-                    with _LOCK:
-                        _state["depth"] -= 1
-                        if _state["depth"] == 0:
-                            _restore()
-
-        return run
-
-    return wrap
+                _install(who)
+                entered = True
+            except Exception:  # no libc, no numba cfunc: run without the message
+                _state["failed"] = True
+        elif _state["depth"] > 0:
+            entered = True
+        if entered:
+            _state["depth"] += 1
+    try:
+        yield
+    finally:
+        if entered:
+            with _LOCK:
+                _state["depth"] -= 1
+                if _state["depth"] == 0:
+                    _restore()

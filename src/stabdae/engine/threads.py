@@ -16,6 +16,8 @@ from concurrent.futures import ThreadPoolExecutor, wait
 
 import numba
 
+from .crash import guard
+
 __all__ = ["default_threads", "run_chunks"]
 
 
@@ -38,7 +40,8 @@ def _chunks(items: int, threads: int, per_thread: int = 8) -> list[tuple[int, in
     return out
 
 
-def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None) -> None:
+def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None,
+               who: str = "ensemble") -> None:
     """Call ``kernel(lo, hi)`` for consecutive ranges covering ``range(items)``.
 
     ``kernel`` must release the GIL (a ``nogil`` dispatcher called with arguments bound by
@@ -49,33 +52,34 @@ def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None)
     """
     if items <= 0:
         return
-    threads = default_threads() if threads is None else max(1, int(threads))
-    threads = min(threads, items, os.cpu_count() or threads)
-    chunks = _chunks(items, threads)
-    done = 0
-    if threads == 1:
-        for lo, hi in chunks:
-            kernel(lo, hi)
-            done += hi - lo
-            if progress is not None:
-                progress(done, items)
-        return
-    kernel(0, 0)
-    pool = _pool(threads)
-    futures = [(hi - lo, pool.submit(kernel, lo, hi)) for lo, hi in chunks]
-    try:
-        for size, fut in futures:
-            fut.result()
-            done += size
-            if progress is not None:
-                progress(done, items)
-    except BaseException:
-        for _, fut in futures:
-            fut.cancel()
-        for _, fut in futures:  # nothing of this call runs on after it has returned
-            if not fut.cancelled():
-                wait([fut])
-        raise
+    with guard(who):  # a crash inside says what happened (.crash)
+        threads = default_threads() if threads is None else max(1, int(threads))
+        threads = min(threads, items, os.cpu_count() or threads)
+        chunks = _chunks(items, threads)
+        done = 0
+        if threads == 1:
+            for lo, hi in chunks:
+                kernel(lo, hi)
+                done += hi - lo
+                if progress is not None:
+                    progress(done, items)
+            return
+        kernel(0, 0)
+        pool = _pool(threads)
+        futures = [(hi - lo, pool.submit(kernel, lo, hi)) for lo, hi in chunks]
+        try:
+            for size, fut in futures:
+                fut.result()
+                done += size
+                if progress is not None:
+                    progress(done, items)
+        except BaseException:
+            for _, fut in futures:
+                fut.cancel()
+            for _, fut in futures:  # nothing of this call runs on after it has returned
+                if not fut.cancelled():
+                    wait([fut])
+            raise
 
 
 _POOLS: dict[int, ThreadPoolExecutor] = {}
