@@ -364,22 +364,6 @@ def test_member_rates_at_a_double_eigenvalue():
     assert np.mean(np.abs(ratio - 1) <= 0.01) >= 0.985
 
 
-def test_member_rates_where_the_step_map_is_a_multiple_of_the_identity():
-    """The midpoint rule at τω = 1 with ξ = 1 (the main study's τ = 1/300, ω = 300):
-    ``R(τÃ) = R(−1) I = I/2``, so each member's ``(f, ḟ)`` keeps its direction and the
-    other direction holds only what does not follow the map.  Its pooled pairs span one
-    direction, and the map is fitted along it: the median within 1 % of ``−ln(1/2)/τ``
-    (a 2 × 2 fit read the other direction's noise as a mode: 1.51 times the rate)."""
-    tau = 1.0 / 300.0
-    ds = stabdae.ensemble(load_scene("pendulum"), stabdae.baumgarte(300.0, 1.0), "rk2", tau,
-                          5.0, members=256, radius=(1e-8, 1e-3), seed=1, epsilon=1.0,
-                          save_dt=0.01, traces="none")  # fmt: skip
-    exact = -math.log(0.5) / tau
-    assert float(ds.beta_theory_discrete) == pytest.approx(exact, rel=1e-12)
-    assert int(ds.members_with_beta) >= 100
-    assert float(ds.beta_median) == pytest.approx(exact, rel=0.01)
-
-
 def test_a_floor_rising_with_the_motion_is_no_growth():
     """The double pendulum under Euler (τ = 1e-4, 5 s): each member's deviation from the
     reference trajectory decays by two decades or more, then rises again as its chaotic

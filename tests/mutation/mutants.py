@@ -716,12 +716,6 @@ MUTANTS = [
             'tests/study/test_run.py::test_every_setting_that_decides_the_numbers_is_in_the_run_key'),
            "the study's resume key leaves out the ensemble settings (--members)"),
     # ---- this round's fixes
-    Mutant("pooled-span-off",
-           E + "decay/onestep.py",
-           "POOLED_SPAN = 1e-3",
-           "POOLED_SPAN = 0.0",
-           ('tests/engine/test_decay.py::test_member_rates_where_the_step_map_is_a_multiple_of_the_identity',),
-           "pooled pairs that span one direction are fitted as a 2 × 2 map"),
     Mutant("cache-entry-unchecked",
            E + "cache.py",
            "        if not raw.startswith(self._MAGIC) or head != want:",

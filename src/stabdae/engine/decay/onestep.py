@@ -46,10 +46,6 @@ CLUSTER = 0.02
 MAP_RANK_TOL = 1e-12
 #: the pairs used lie above this many times the floor (then ``FLOOR_MARGIN``)
 MAP_MARGIN = 100.0
-#: pooled pairs ``(f, ḟ)`` whose whitened sums' smaller eigenvalue is below this fraction
-#: of the larger span one direction: the map is fitted along it alone (a 2 × 2 fit reads
-#: the other direction's noise as a mode)
-POOLED_SPAN = 1e-3
 #: all pairs are used when the largest norm fell from each of the last three fifths to
 #: the next, by this factor from the third to the fifth: the run ended inside the
 #: transient, where the largest norm of the last fifth is no floor (the map needs no
@@ -535,19 +531,7 @@ def _pooled_radius(S, j, first, ref):
         s[c] = S[j, first, c] if first < S.shape[1] else 0.0
     rho = -1.0
     det = s[0] * s[3] - s[1] * s[2]
-    # the pairs' correlation: ±1 where (f, ḟ) keeps one direction (R a multiple of the
-    # identity on it), and the other direction holds only what does not follow the map
-    corr = s[1] / math.sqrt(s[0] * s[3]) if s[0] > 0.0 and s[3] > 0.0 else 1.0
-    if s[0] > 0.0 and s[3] > 0.0 and (1.0 - abs(corr)) < POOLED_SPAN * (1.0 + abs(corr)):
-        # one direction spanned: the map along it (the top eigenvector v of S0)
-        half = 0.5 * (s[0] - s[3])
-        top = 0.5 * (s[0] + s[3]) + math.sqrt(half * half + s[1] * s[1])
-        v0, v1 = (s[1], top - s[0]) if abs(s[1]) > 0.0 else (1.0, 0.0)
-        den = v0 * v0 * s[0] + 2.0 * v0 * v1 * s[1] + v1 * v1 * s[3]
-        num = v0 * v0 * s[4] + v0 * v1 * (s[5] + s[6]) + v1 * v1 * s[7]
-        if den > 0.0:
-            rho = abs(num / den)
-    elif s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:  # S1 S0⁻¹
+    if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:  # S1 S0⁻¹
         rho = _radius2_grouped((s[4] * s[3] - s[5] * s[2]) / det,
                                (s[5] * s[0] - s[4] * s[1]) / det,
                                (s[6] * s[3] - s[7] * s[2]) / det,
