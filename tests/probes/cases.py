@@ -597,33 +597,39 @@ def study_second_run_on_the_same_output_while_one_runs(ctx):
     return _cli_outcome(code, out, err, "stabdae run", None, ctx, path)
 
 
-@case("ok", "stabdae run")
-def study_interrupted_then_resumed_is_bit_identical(ctx):
+def _stopped_then_resumed(ctx, name: str, stop) -> None:
+    """A four-point study stopped by ``stop(process)`` once its first part is written,
+    then the same command: its dataset must be a clean run's, number for number."""
     body = _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [1e-3, 2e-3, 4e-3, 8e-3]")
     body = _replace(body, "t_end = 0.2", "t_end = 2.0")
-    clean = ctx.study("clean", body)
+    clean = ctx.study(f"clean_{name}", body)
     code, _, err = ctx.cli("run", clean, cwd=clean.parent)
     assert code == 0, err[-2000:]
-    path = ctx.study("interrupted", body)
+    path = ctx.study(name, body)
     environ = dict(os.environ, PYTHONPATH=str(ctx.src))
-    proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)],
-                            cwd=path.parent, env=environ, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)], cwd=path.parent,
+                            env=environ, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)  # fmt: skip
     parts = path.parent / "out.nc.parts"
     deadline = time.time() + 300
     while time.time() < deadline and len(list(parts.glob("*.nc"))) < 1:
         time.sleep(0.05)
-    proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=300)
-    code, _, err2 = ctx.cli("run", path, cwd=path.parent)
-    assert code == 0, err2[-2000:]
+    stop(proc)
+    proc.wait(timeout=300)
+    code, _, err = ctx.cli("run", path, cwd=path.parent)
+    assert code == 0, err[-2000:]
     import xarray as xr
 
     with (xr.open_dataset(clean.parent / "out.nc") as a,
           xr.open_dataset(path.parent / "out.nc") as b):
-        for name in a.data_vars:
-            if a[name].dtype.kind in "fiu":
-                np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+        for var in a.data_vars:
+            if a[var].dtype.kind in "fiu":
+                np.testing.assert_array_equal(a[var].values, b[var].values, err_msg=var)
+
+
+@case("ok", "stabdae run")
+def study_interrupted_then_resumed_is_bit_identical(ctx):
+    _stopped_then_resumed(ctx, "interrupted", lambda proc: proc.send_signal(signal.SIGINT))
 
 
 @case("ok", "stabdae run")
@@ -728,32 +734,8 @@ def cache_entries_swapped_are_recompiled(ctx):
 # ------------------------------------------------------------ more faults and commands
 @case("ok", "stabdae run")
 def study_killed_hard_then_resumed_is_bit_identical(ctx):
-    """SIGKILL (no clean-up at all) part-way, then the same command: the finished points
-    are kept, the rest computed, and the dataset is that of a clean run."""
-    body = _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [1e-3, 2e-3, 4e-3, 8e-3]")
-    body = _replace(body, "t_end = 0.2", "t_end = 2.0")
-    clean = ctx.study("clean_kill", body)
-    code, _, err = ctx.cli("run", clean, cwd=clean.parent)
-    assert code == 0, err[-2000:]
-    path = ctx.study("killed", body)
-    environ = dict(os.environ, PYTHONPATH=str(ctx.src))
-    proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)], cwd=path.parent,
-                            env=environ, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    parts = path.parent / "out.nc.parts"
-    deadline = time.time() + 300
-    while time.time() < deadline and len(list(parts.glob("*.nc"))) < 1:
-        time.sleep(0.05)
-    proc.kill()
-    proc.wait()
-    code, _, err = ctx.cli("run", path, cwd=path.parent)
-    assert code == 0, err[-2000:]
-    import xarray as xr
-
-    with (xr.open_dataset(clean.parent / "out.nc") as a,
-          xr.open_dataset(path.parent / "out.nc") as b):
-        for name in a.data_vars:
-            if a[name].dtype.kind in "fiu":
-                np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+    """SIGKILL (no clean-up at all) part-way, then the same command."""
+    _stopped_then_resumed(ctx, "killed", lambda proc: proc.kill())
 
 
 @case("ok", "stabdae run")
