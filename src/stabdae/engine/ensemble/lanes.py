@@ -237,6 +237,9 @@ def _build_adaptive_block(K, spec: Spec):
         lm = stack2(LR, LC)
         ls = stack1(1)
         copy_inputs(p, law_mat, law_scal, p_s, lm, ls)
+        at = stack1(N2)  # atol per component, on the stack for the same reason
+        for l in range(N2):
+            at[l] = atol[l]
         ta = stack2(s, s)
         tb = stack1(s)
         tc = stack1(s)
@@ -443,7 +446,7 @@ def _build_adaptive_block(K, spec: Spec):
                     h = h0
                     if st == 0:
                         h, nf = first_step(t0, x_h, k0_h, k1_h, xs_h, p, law_mat, law_scal,
-                                           ws_h, rtol, atol, h0, tend, expo)  # fmt: skip
+                                           ws_h, rtol, at, h0, tend, expo)  # fmt: skip
                         fev_n[lane] += nf
                         hh, hit[lane], st = _next_step(t0, h, tend, 0, max_steps)
                     if st != 0:
@@ -495,7 +498,7 @@ def _build_adaptive_block(K, spec: Spec):
                     x[l] = X[l, lane]
                     k0[l] = K0[l, lane]
                 good, nev, e, r = attempt(T[lane], HH[lane], x, k0, p_s, lm, ls, ta, tb, te,
-                                          tc, rtol, atol, ws, xs, xn, kl)  # fmt: skip
+                                          tc, rtol, at, ws, xs, xn, kl)  # fmt: skip
                 for l in range(N2):
                     XN[l, lane] = xn[l]
                     KL[l, lane] = kl[l]
