@@ -11,7 +11,7 @@ prints the Python stack; otherwise the process dies as before).  The process is 
 saved: the memory may already be corrupt.
 
 The handler is a numba ``cfunc`` that calls only ``write``, ``strlen`` and ``sigaction``
-(async-signal-safe), compiled once per process on the first guarded call (about 0.4 s: the
+(async-signal-safe), compiled once per process under the first guard (about 0.4 s: the
 addresses it writes from are this process's).  Linux only; elsewhere, or with
 ``STABDAE_CRASH_MESSAGE=off``, nothing is installed.
 """
