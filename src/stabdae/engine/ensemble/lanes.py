@@ -116,6 +116,7 @@ BUFFERS = {
     "p_s": ("stack1(NP)", "the parameters"),
     "lm": ("stack2(LR, LC)", "the law's matrix"),
     "ls": ("stack1(1)", "the law's scalar"),
+    "at": ("stack1(N2)", "atol, one per state component"),
     "ta": ("stack2(s, s)", "the pair's A"),
     "tb": ("stack1(s)", "the pair's b"),
     "tc": ("stack1(s)", "the pair's c"),
