@@ -131,13 +131,12 @@ def tolerances(rtol, atol, who: str, size: int):
             raise ValueError(f"{who}: atol must be positive and finite in every component; "
                              f"components {bad.tolist()} are {vector[bad].tolist()}")
         given = vector.copy()
-    atol = vector
     if rtol < 100 * np.finfo(float).eps:
         raise ValueError(
             f"{who}: rtol = {rtol:g} is below 100 machine epsilons "
             f"({100 * np.finfo(float).eps:.1e}); the error estimate is roundoff"
         )
-    return rtol, np.ascontiguousarray(atol), given
+    return rtol, np.ascontiguousarray(vector), given
 
 
 def count(value, name: str, who: str) -> int:
