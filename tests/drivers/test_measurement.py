@@ -391,3 +391,31 @@ def test_member_rates_on_models_the_project_does_not_ship(name, scheme, xi):
     ratio = ds.beta_ratio.values[above].astype(float)
     assert above.sum() >= 60, above.sum()
     assert np.mean(np.abs(ratio - 1.0) <= 0.01) >= 0.98
+
+
+def test_a_law_whose_step_is_a_multiple_of_the_identity():
+    """The midpoint rule at ``τω = 1`` with ``ξ = 1`` (ω = 300, τ = 1/300, a point of the
+    main study's grid): ``R(τÃ) = I/2``, so every member's distance from the reference
+    keeps the direction of its ``α⁰`` and its pairs span one direction.  The map is then
+    fitted as ``ĉ I`` and every member's β is ``ln 2/τ`` to 1 % (the general 2 × 2 fit
+    read the floor's motion across that direction as a second mode: ratios 0.30 … 2.76,
+    median 1.50).  The law's map of a scalar is recognized, a Jordan block of the same
+    modulus is not.  (Members up to 1e-4: the scheme's remainder at τω = 1 is large, the
+    reference's floor 6e-3, and couples a larger perturbation to the motion: measured
+    1.5 % at 7e-4, 3 % at 1e-3, growing with ‖α⁰‖.)"""
+    from stabdae._schemes import as_scheme
+    from stabdae.engine.decay import reference_logs
+    from stabdae.theory import step_matrix
+
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(300, 1)
+    R = step_matrix(law.A_tilde(model), as_scheme("midpoint"), 1 / 300)
+    np.testing.assert_allclose(R, np.eye(2) / 2, atol=1e-12)
+    ds = stabdae.ensemble(model, law, "midpoint", 1 / 300, 2.0, members=64,
+                          radius=(1e-8, 1e-4), seed=1, traces="none")  # fmt: skip
+    assert float(ds.beta_theory_discrete) == pytest.approx(300 * math.log(2), rel=1e-12)
+    ratio = ds.beta_ratio.values[np.isfinite(ds.beta_ratio.values)]
+    assert ratio.size >= 16
+    assert np.all(np.abs(ratio - 1) < 0.01), np.sort(ratio)
+    assert reference_logs(R).shape == (1,)
+    assert reference_logs(np.array([[0.5, 1e-3], [0.0, 0.5]])).shape == (2,)

@@ -369,13 +369,41 @@ def _cluster_radius(moduli, n):
 #: eigenvalues of the law's one-step map ``R`` whose ``ln`` moduli differ by less than
 #: this (relative) are one repeated eigenvalue (:func:`reference_logs`)
 SAME_MODULUS = 1e-6
+#: a law's one-step map within this (relative to its diagonal) of a multiple of the
+#: identity is one (:func:`reference_logs`): a fitted map constrained to ``c I`` is then
+#: off by at most about this much
+SCALAR_MAP = 1e-9
+
+
+@njit(cache=True)
+def _scalar_log(R):
+    """``ln |c|`` where ``R`` is ``c I`` (within ``SCALAR_MAP``) with ``c ≠ 0``, else NaN."""
+    n = R.shape[0]
+    c = 0.0
+    for i in range(n):
+        c += R[i, i]
+    c /= n
+    if not (abs(c) > 0.0) or not math.isfinite(c):
+        return math.nan
+    for i in range(n):
+        for q in range(n):
+            if abs(R[i, q] - (c if i == q else 0.0)) > SCALAR_MAP * abs(c):
+                return math.nan
+    return math.log(abs(c))
 
 
 @njit(cache=True)
 def reference_logs(R):
     """The distinct ``ln |λ|`` of the eigenvalues of the law's one-step map ``R`` (NaN
     entries past the distinct ones; none for an empty ``R`` or a zero eigenvalue's
-    ``−inf``): the groups a fitted map's eigenvalues are read in (:func:`_grouped`)."""
+    ``−inf``): the groups a fitted map's eigenvalues are read in (:func:`_grouped`).
+
+    Where ``R`` is a multiple ``c I`` of the identity (within ``SCALAR_MAP``), the one
+    entry ``ln |c|``, without padding: the fits then take ``R̂ = ĉ I``
+    (:func:`is_scalar_law`).  Every member's residual then keeps the direction of its
+    ``α⁰``, so its pairs span one direction and a general fit reads the floor's motion
+    across it as a second mode (the midpoint rule at ``τω = 1``, ``ξ = 1``: ``R = I/2``,
+    and the general 2 × 2 fit read rates from 0.3 to 2.8 times the law's)."""
     n = R.shape[0]
     out = np.full(max(n, 1), math.nan)
     if n == 0:
@@ -384,6 +412,12 @@ def reference_logs(R):
         for q in range(n):
             if not math.isfinite(R[i, q]):
                 return out
+    if n > 1:
+        x = _scalar_log(R)
+        if x == x:
+            one = np.empty(1)
+            one[0] = x
+            return one
     lam = np.linalg.eigvals(R.astype(np.complex128))
     count = 0
     for i in range(n):
@@ -399,6 +433,14 @@ def reference_logs(R):
             out[count] = x
             count += 1
     return out
+
+
+@njit(cache=True)
+def is_scalar_law(ref):
+    """Whether ``ref`` (:func:`reference_logs`) is that of a law whose one-step map is a
+    multiple of the identity (one finite entry, as only such a map of size > 1, or one
+    of size 1, gives)."""
+    return ref.shape[0] == 1 and math.isfinite(ref[0])
 
 
 @njit(cache=True)
@@ -529,6 +571,10 @@ def _pooled_radius(S, j, first, ref):
     s = stack1(11)
     for c in range(11):
         s[c] = S[j, first, c] if first < S.shape[1] else 0.0
+    if is_scalar_law(ref):  # R̂ = ĉ I over the pairs of both blocks
+        den = s[0] + s[3] + s[8]
+        rho = abs(s[4] + s[7] + s[9]) / den if den > 0.0 else math.nan
+        return rho, s[10]
     rho = -1.0
     det = s[0] * s[3] - s[1] * s[2]
     if s[0] > 0.0 and s[3] > 0.0 and abs(det) > 1e-14 * s[0] * s[3]:  # S1 S0⁻¹
@@ -593,6 +639,13 @@ def _map_radius(S, j, ng, first, ref):
                 S1[r, q] = S[j, first, c]
                 c += 1
         pairs = S[j, first, c]
+    if is_scalar_law(ref) and pairs >= 1.0:  # R̂ = ĉ I
+        num = 0.0
+        den = 0.0
+        for r in range(ng):
+            num += S1[r, r]
+            den += S0[r, r]
+        return (abs(num) / den if den > 0.0 else math.nan), pairs
     if pairs < 2.0 * ng:
         return math.nan, pairs
     lam, V = _spanned(S0, S1, S1)
