@@ -22,7 +22,8 @@ import xarray as xr
 from . import _measures, theory
 from . import _validate as check
 from ._codes import Status
-from ._ensemble_dataset import _ensemble_dataset, _warn_stopped
+from ._ensemble_dataset import Table, _warn_stopped
+from ._ensemble_dataset import ensemble_table as _table
 from ._model import Model
 from ._raised import first_raising_member, model_raised, stage_finder
 from .engine.crash import guard
@@ -277,6 +278,22 @@ def ensemble(
         When members stopped (diverged, singular ``S``, …), with their count per reason;
         their rows are kept up to the stop, and ``status`` says why per member.
     """
+    table = ensemble_table(model, law, scheme, tau, t_end, rtol=rtol, atol=atol,
+                           members=members, radius=radius, seed=seed, save_dt=save_dt, x0=x0,
+                           params=params, epsilon=epsilon, divergence=divergence, block=block,
+                           threads=threads, progress=progress, residual_dtype=residual_dtype,
+                           traces=traces, states=states)  # fmt: skip
+    _warn_stopped(table.attrs["model"], table.data["status"][1])
+    return table.to_dataset()
+
+
+def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, atol=None,
+                   members=1024, radius=(1e-6, 1e-2), seed=0, save_dt=None, x0=None,
+                   params=None, epsilon=None, divergence=None, block=None, threads=None,
+                   progress=None, residual_dtype="float32", traces=DEFAULT_TRACES,
+                   states=True) -> Table:  # fmt: skip
+    """:func:`ensemble`'s dataset as a :class:`~._ensemble_dataset.Table` (what a study
+    keeps per grid point), without the warning for stopped members."""
     run = _run_spec("ensemble", model, law, scheme, tau, t_end, rtol, atol, members, radius,
                     seed, save_dt, x0, params, epsilon, divergence, block, threads, progress,
                     residual_dtype, traces, states)  # fmt: skip
@@ -298,7 +315,7 @@ def ensemble(
                   if run.R.shape[0] > 0 else (math.nan, math.inf))  # fmt: skip
     referee = _referee(run, g_ref)
     times = run.mode.times(run.t0)
-    ds = _ensemble_dataset(
+    table = _table(
         run.model, run.p, run.law, run.scheme, run.bound, times, x0, alpha0, out.norms,
         run.traced, out.x_final, status, out.fail_step, out.e0, out.e1, run.epsilon,
         Record(out.meas, out.codes), run.R,
@@ -312,12 +329,11 @@ def ensemble(
         referee=referee,
     )  # fmt: skip
     if not run.states:
-        ds = ds.drop_vars(["x0", "x_final"])
+        del table.data["x0"], table.data["x_final"]
     # wall times (compilation included on a first call) for benchmarks; not part of the data
-    ds.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
-                    wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
-    _warn_stopped(run.model, status)
-    return ds
+    table.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
+                       wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
+    return table
 
 
 # --------------------------------------------------------------------- the run spec

@@ -1,13 +1,19 @@
 """The dataset of an ensemble, built from what its kernel returned: the measurement
 record read by column name, the per-member classes and summaries (:mod:`._measures`),
 the theorems' predictions (:mod:`.theory`), the schema's variables and the provenance
-(:mod:`._schema`); and the one warning for the members that stopped."""
+(:mod:`._schema`); and the one warning for the members that stopped.
+
+It is built as a :class:`Table` of plain arrays first, which :meth:`Table.to_dataset`
+turns into an ``xarray.Dataset``: a study keeps its grid points' tables and makes one
+dataset of them all (building an ``xarray.Dataset`` per grid point cost more than the
+ensemble's integration on small studies)."""
 
 from __future__ import annotations
 
 import math
 import warnings
 from collections import Counter
+from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
@@ -16,11 +22,32 @@ from . import _measures, theory
 from ._codes import Status
 from ._integrate import IntegrationWarning
 from ._laws import Theorem5
-from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_variable, variable
+from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_entry, variable
 from .engine import decay
 
 
-def _warn_stopped(model, status) -> None:
+@dataclass
+class Table:
+    """A dataset as plain arrays: ``data`` maps each variable's name to ``(dims, values,
+    attrs)``, ``coords`` each coordinate's name to an ``xarray.Variable``, ``attrs`` the
+    global attributes.  What :meth:`to_dataset` gives is what :func:`stabdae.ensemble`
+    returns."""
+
+    data: dict
+    coords: dict
+    attrs: dict = field(default_factory=dict)
+
+    def to_dataset(self) -> xr.Dataset:
+        return xr.Dataset(self.data, coords=self.coords, attrs=self.attrs)
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> Table:
+        """The table of ``ds`` (its arrays, not copies)."""
+        data = {k: (v.dims, v.values, dict(v.attrs)) for k, v in ds.data_vars.items()}
+        return cls(data, {k: ds[k].variable for k in ds.coords}, dict(ds.attrs))
+
+
+def _warn_stopped(name: str, status) -> None:
     """One warning for the members that stopped, counted by reason (as :func:`integrate`
     warns for one trajectory)."""
     stopped = Counter(int(s) for s in status[status != 0])
@@ -29,17 +56,18 @@ def _warn_stopped(model, status) -> None:
     reasons = ", ".join(f"{n} {Status(s).short}" for s, n in sorted(stopped.items()))
     total = sum(stopped.values())
     warnings.warn(
-        f"ensemble({model.name}): {total} of {status.shape[0]} members stopped: {reasons}; "
+        f"ensemble({name}): {total} of {status.shape[0]} members stopped: {reasons}; "
         "their samples up to the stop are kept (see the status variable)",
         IntegrationWarning,
         stacklevel=3,
     )
 
 
-def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
-                      x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
-                      extra=None, roundoff=0.0, overshoot_theory=math.nan,
-                      adaptive=False, referee=None):  # fmt: skip
+def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
+                   x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
+                   extra=None, roundoff=0.0, overshoot_theory=math.nan,
+                   adaptive=False, referee=None) -> Table:  # fmt: skip
+    """The ensemble's :class:`Table` from what its kernel returned."""
     stopped = status != 0
     for name in ("beta_predicted", "beta", "gamma"):  # (not placed: measured on nothing)
         meas[name][stopped] = np.nan
@@ -109,18 +137,17 @@ def _ensemble_dataset(model, p, law, scheme, bound, times, x0, alpha0, norms, tr
     for name in COUNTS:
         if name in values:
             values[name] = np.asarray(values[name], dtype=np.int32)
-    data = {name: schema_variable(name, val, model) for name, val in values.items()}
-    data["residual_norm"].attrs["comment"] = (
-        f"stored as {norms.dtype}; " + data["residual_norm"].attrs["comment"]
-    )
-    data["stability_radius"].attrs["comment"] = radius_why
+    data = {name: schema_entry(name, val, model) for name, val in values.items()}
+    attrs = data["residual_norm"][2]
+    attrs["comment"] = f"stored as {norms.dtype}; " + attrs["comment"]
+    data["stability_radius"][2]["comment"] = radius_why
     attrs = provenance(model, p, law, scheme, f"ensemble of {x0.shape[0]} members", **run)
     attrs["verdict_summary"] = _measures.verdict_summary(verdicts, why, cls != _measures.NOT_RUN)
     if referee is not None:
         attrs["reference_floor"] = np.asarray(referee["floor_band"], dtype=float)
     attrs["roundoff_level"] = float(roundoff)
     attrs["residual_norm_dtype"] = str(norms.dtype)
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return Table(data, coords, attrs)
 
 
 def _theory_values(law, model, p, scheme, tau, adaptive, x0, x_final, times, norms, traced,

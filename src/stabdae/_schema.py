@@ -398,13 +398,19 @@ def schema_variable(name: str, data, model=None, dims=None, key: str | None = No
                     ) -> xr.Variable:  # fmt: skip
     """Variable ``name`` of :data:`SCHEMA` (entry ``key``, default ``name``) holding
     ``data``; ``dims`` replaces the schema's (a study grid's axes)."""
+    return xr.Variable(*schema_entry(name, data, model, dims, key))
+
+
+def schema_entry(name: str, data, model=None, dims=None, key: str | None = None) -> tuple:
+    """:func:`schema_variable` as ``(dims, data, attrs)``, without building the
+    ``xarray.Variable``."""
     sdims, long_name, marker, extra = SCHEMA[name if key is None else key]
     attrs = {"long_name": long_name, **_resolve_units(marker, model), **extra}
     if "comment" in extra and "comment_units" in attrs:
         attrs["comment"] = f"{extra['comment']}; {attrs.pop('comment_units')}"
     elif "comment_units" in attrs:
         attrs["comment"] = attrs.pop("comment_units")
-    return xr.Variable(sdims if dims is None else dims, data, attrs=attrs)
+    return (sdims if dims is None else dims), data, attrs
 
 
 def component_coords(model) -> dict:

@@ -598,7 +598,7 @@ def study_second_run_on_the_same_output_while_one_runs(ctx):
 
 
 def _stopped_then_resumed(ctx, name: str, stop) -> None:
-    """A four-point study stopped by ``stop(process)`` once its first part is written,
+    """A four-point study stopped by ``stop(process)`` once its first chunk is written,
     then the same command: its dataset must be a clean run's, number for number."""
     body = _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [1e-3, 2e-3, 4e-3, 8e-3]")
     body = _replace(body, "t_end = 0.2", "t_end = 2.0")
@@ -606,13 +606,13 @@ def _stopped_then_resumed(ctx, name: str, stop) -> None:
     code, _, err = ctx.cli("run", clean, cwd=clean.parent)
     assert code == 0, err[-2000:]
     path = ctx.study(name, body)
-    environ = dict(os.environ, PYTHONPATH=str(ctx.src))
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src), STABDAE_FLUSH_SECONDS="0")
     proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path)], cwd=path.parent,
                             env=environ, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)  # fmt: skip
     parts = path.parent / "out.nc.parts"
     deadline = time.time() + 300
-    while time.time() < deadline and len(list(parts.glob("*.nc"))) < 1:
+    while time.time() < deadline and len(list(parts.glob("chunk-*.npz"))) < 1:
         time.sleep(0.05)
     stop(proc)
     proc.wait(timeout=300)
@@ -638,7 +638,7 @@ def study_damaged_part_is_recomputed(ctx):
     code, _, err = ctx.cli("run", path, cwd=path.parent)
     assert code == 0, err[-2000:]
     first = (path.parent / "out.nc").read_bytes()
-    parts = sorted((path.parent / "out.nc.parts").glob("*.nc"))
+    parts = sorted((path.parent / "out.nc.parts").glob("chunk-*.npz"))
     if not parts:  # parts are cleaned up after a finished run: damage one mid-run instead
         return
     data = bytearray(parts[0].read_bytes())

@@ -24,6 +24,16 @@ from stabdae.study.run import run_study
 ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "src"
 
+
+def recorded(parts: Path) -> int:
+    """The grid points whose chunks the manifest of ``parts`` records (0 before it is)."""
+    try:
+        chunks = json.loads((parts / "study.json").read_text()).get("chunks", {})
+    except (OSError, ValueError):
+        return 0
+    return sum(len(c["points"]) for c in chunks.values())
+
+
 def test_run_writes_dataset_and_pictures_and_refuses_to_overwrite(tmp_path, capsys):
     path = study_file(tmp_path)
     assert main(["run", str(path), "--quiet"]) == 0
@@ -64,7 +74,8 @@ def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
     (tmp_path / "ref").mkdir()
     reference = run_study(study_file(tmp_path / "ref", members=8192, t_end=5.0, omegas="5.0"),
                           progress=False, log=lambda *a: None)  # fmt: skip
-    env = dict(os.environ, PYTHONPATH=str(SRC))
+    # a chunk per grid point, so that the kill lands between two
+    env = dict(os.environ, PYTHONPATH=str(SRC), STABDAE_FLUSH_SECONDS="0")
     cmd = [sys.executable, "-m", "stabdae.study.cli", "run", str(path), "--quiet", "--no-plots"]
     parts = tmp_path / "out" / "study.nc.parts"
 
@@ -78,7 +89,7 @@ def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
         proc = subprocess.Popen(command, env=env, stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True)  # fmt: skip
         deadline = time.time() + 120
-        while time.time() < deadline and len(list(parts.glob("point-*.nc"))) < points:
+        while time.time() < deadline and recorded(parts) < points:
             time.sleep(0.01)
         return proc
 
@@ -89,17 +100,15 @@ def test_resume_after_sigkill_gives_the_same_dataset(tmp_path):
     assert proc.returncode == 130, err
     assert "Traceback" not in err and err.strip().count("\n") == 0, err
     assert "interrupted (the grid points done are kept: run the same command to resume)" in err
-    assert len(list(parts.glob("point-*.nc"))) >= 1
+    assert recorded(parts) >= 1
     assert not (parts / "lock").exists()
-    # then SIGKILL, in the middle of the resumed run
+    # then SIGKILL, in the middle of the resumed run; the points finished since the last
+    # chunk are computed again, as is a chunk written but not yet recorded
     proc = start_and_wait_for(2)
     os.kill(proc.pid, signal.SIGKILL)
     proc.communicate()
-    assert 2 <= len(list(parts.glob("point-*.nc"))) < 6  # killed in the middle
-    # the parts whose checksums the manifest holds: one written but not yet recorded when
-    # the kill came is computed again
-    done = len(json.loads((parts / "study.json").read_text())["parts"])
-    assert done >= 1
+    done = recorded(parts)
+    assert 2 <= done < 6  # killed in the middle
     assert not (tmp_path / "out" / "study.nc").exists()
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
     assert f"resuming: {done} of 6 grid points already done" in out.stdout
@@ -120,10 +129,10 @@ def test_run_refuses_the_parts_of_another_study(tmp_path):
     parts.mkdir(parents=True)
     (parts / "study.json").write_text(json.dumps(
         {"fingerprint": _fingerprint(load_study(other)), "study": str(other)}))
-    (parts / "point-0.nc").write_bytes(b"not this study's")
+    (parts / "chunk-0.npz").write_bytes(b"not this study's")
     with pytest.raises(FileExistsError, match="holds a run of a different study"):
         run_study(mine, progress=False, log=lambda *a: None)
-    assert (parts / "point-0.nc").exists()
+    assert (parts / "chunk-0.npz").exists()
     out = run_study(mine, force=True, progress=False, log=lambda *a: None)
     assert out.exists() and not parts.exists()
 
@@ -226,7 +235,7 @@ def test_resume_after_a_model_edit_recomputes_and_equals_a_clean_run(tmp_path, m
     study = tmp_path / "study.toml"
     study.write_text(text)
     _interrupted(study, 2, monkeypatch)
-    assert len(list((tmp_path / "out" / "study.nc.parts").glob("point-*.nc"))) == 2
+    assert recorded(tmp_path / "out" / "study.nc.parts") == 2
     (models / "pend.py").write_text(source.replace('"g": 9.81', '"g": 1.62'))
     env = dict(os.environ, PYTHONPATH=str(SRC))
     cmd = [sys.executable, "-m", "stabdae.study.cli", "run", str(study), "--quiet", "--no-plots"]
@@ -276,34 +285,47 @@ def test_the_run_key_covers_helpers_outside_the_model_folder(tmp_path, monkeypat
 
 
 def test_bad_parts_are_computed_again_and_force_keeps_good_ones(tmp_path, monkeypatch):
-    """Each part is checked before it is used: a part of another grid point, a truncated,
-    an empty and an altered part (its checksum differs from the one recorded when it was
-    written) are computed again, and say so.  --force replaces the finished output but
-    resumes from the parts of this run.  Every way ends with the dataset of a clean run."""
+    """Each chunk of the store is checked before it is used: a chunk replaced by another's
+    bytes, a truncated one, a missing one and one rewritten with other numbers (their
+    checksums differ from those recorded when they were written), and one whose recorded
+    checksum was edited to match but holds other grid points, are computed again, and
+    say so; a chunk the manifest does not record (a kill between the two writes) is
+    removed.  --force replaces the finished output but resumes from the chunks of this
+    run.  Every way ends with the dataset of a clean run."""
+    monkeypatch.setenv("STABDAE_FLUSH_SECONDS", "0")  # a chunk per grid point
     study = study_file(tmp_path, members=16, t_end=0.2, omegas="5.0")
     (tmp_path / "ref").mkdir()
     clean = run_study(study_file(tmp_path / "ref", members=16, t_end=0.2, omegas="5.0"),
                       progress=False, log=lambda *a: None)  # fmt: skip
     parts = tmp_path / "out" / "study.nc.parts"
-    _interrupted(study, 5, monkeypatch)
-    (parts / "point-0.nc").write_bytes((parts / "point-1.nc").read_bytes())  # a foreign part
-    data = (parts / "point-2.nc").read_bytes()
-    (parts / "point-2.nc").write_bytes(data[: len(data) // 2])  # truncated
-    (parts / "point-3.nc").write_bytes(b"")  # empty
-    with xr.open_dataset(parts / "point-4.nc") as part:  # opens, right key, other numbers
-        tampered = part.load()
-    tampered["fraction_bounded"] = tampered.fraction_bounded * 0 + 0.5
-    write_netcdf(tampered, parts / "point-4.nc")
+    _interrupted(study, 6 - 1, monkeypatch)
+    manifest = json.loads((parts / "study.json").read_text())
+    assert [manifest["chunks"][f"chunk-{i}.npz"]["points"] for i in range(5)] == \
+        [[0], [1], [2], [3], [4]]
+    (parts / "chunk-0.npz").write_bytes((parts / "chunk-1.npz").read_bytes())
+    data = (parts / "chunk-2.npz").read_bytes()
+    (parts / "chunk-2.npz").write_bytes(data[: len(data) // 2])  # truncated
+    (parts / "chunk-3.npz").unlink()
+    with np.load(parts / "chunk-4.npz") as npz:  # opens, right key, other numbers
+        arrays = dict(npz)
+    arrays["d/fraction_bounded"] = arrays["d/fraction_bounded"] * 0 + 0.5
+    np.savez(parts / "chunk-4.npz", **arrays)
+    # chunk 1's bytes under the name of chunk 5, with a checksum that matches
+    (parts / "chunk-5.npz").write_bytes((parts / "chunk-1.npz").read_bytes())
+    manifest["chunks"]["chunk-5.npz"] = {**manifest["chunks"]["chunk-1.npz"], "points": [5]}
+    (parts / "study.json").write_text(json.dumps(manifest))
+    (parts / "chunk-6.npz").write_bytes(b"written, never recorded")
     said = []
     out = run_study(study, progress=False, log=said.append)
     said = "\n".join(map(str, said))
-    assert "grid point 0: point-0.nc holds grid point 1: computing it again" in said
-    assert "grid point 2: point-2.nc unreadable" in said
-    assert "grid point 3: point-3.nc unreadable" in said
-    assert "grid point 4: point-4.nc does not match its recorded checksum" in said
+    assert "grid points 0: chunk-0.npz does not match its recorded checksum" in said
+    assert "grid points 2: chunk-2.npz does not match its recorded checksum" in said
+    assert "grid points 3: chunk-3.npz is missing: computing them again" in said
+    assert "grid points 4: chunk-4.npz does not match its recorded checksum" in said
+    assert "grid points 5: chunk-5.npz holds other grid points than recorded" in said
     assert "resuming: 1 of 6 grid points already done" in said
     same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
-    # --force replaces the output; the parts this run wrote are resumed, not discarded
+    # --force replaces the output; the chunks this run wrote are resumed, not discarded
     out.unlink()
     _interrupted(study, 2, monkeypatch)
     out.write_bytes(clean.read_bytes())
@@ -311,6 +333,39 @@ def test_bad_parts_are_computed_again_and_force_keeps_good_ones(tmp_path, monkey
     out = run_study(study, force=True, progress=False, log=said.append)
     assert "resuming: 2 of 6 grid points already done" in said
     same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
+
+
+def test_the_store_gives_back_every_table_as_it_was(tmp_path):
+    """A chunk read back gives each grid point's table exactly: the values, their types,
+    the dimensions, every attribute (numpy scalars and arrays of their own type, a
+    variable's attribute that differs between points, a global one that one point lacks)
+    and the coordinates."""
+    from stabdae.study.spec import load_study
+    from stabdae.study.store import Manifest, Store
+
+    study = load_study(study_file(tmp_path, members=16, t_end=0.2, omegas="5.0, 30.0"))
+    from stabdae.study.run import run_point
+
+    tables = {i: run_point(study, values) for i, (_, values) in enumerate(study.points())}
+    tables[3].data["stability_radius"][2]["comment"] = "this point's own"
+    tables[2].attrs["only_here"] = np.float32(0.25)
+    del tables[1].attrs["model"]
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    store = Store(Manifest(parts, "key", "study"))
+    for i, table in tables.items():
+        store.add(i, table)
+    store.flush()
+    again = Store(Manifest.read(parts))
+    again.resume(len(tables), log=lambda *a: pytest.fail(str(a)))
+    assert sorted(again.tables) == sorted(tables)
+    for i, table in tables.items():
+        got = again.tables[i]
+        xr.testing.assert_identical(got.to_dataset(), table.to_dataset())
+        for name, (_, values, _) in table.data.items():
+            assert got.data[name][1].dtype == np.asarray(values).dtype, name
+        assert got.attrs.keys() == table.attrs.keys()
+    assert type(again.tables[2].attrs["only_here"]) is np.float32
 
 
 def test_force_never_removes_what_stabdae_did_not_write(tmp_path):

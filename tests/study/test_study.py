@@ -198,7 +198,7 @@ def test_states_are_stored_when_the_study_asks(tmp_path):
 
     for text, stored in ((BASE, False), (BASE + "states = true\n", True)):
         study = load_study(write(tmp_path, text))
-        ds = run_point(study, dict(study.points())[()])
+        ds = run_point(study, dict(study.points())[()]).to_dataset()
         assert ("x0" in ds and "x_final" in ds) is stored and ds.sizes["member"] == 16
 
 
@@ -321,7 +321,7 @@ def test_shipped_theorem5_study_runs_with_more_members_than_traces(monkeypatch):
     monkeypatch.chdir(root)
     study = load_study(root / "studies" / "sleigh_theorem5_tau_k.toml")
     *_, (_, values) = study.points()  # the largest step: the cheapest point
-    ds = run_point(study, values)
+    ds = run_point(study, values).to_dataset()
     assert ds.sizes["member"] == study.ensemble["members"] > ds.sizes["trace"] > 0
     for which in ("proven", "printed"):
         held = ds[f"bound_{which}_held"]

@@ -2,13 +2,13 @@
 
 Each grid point is one :func:`stabdae.ensemble` with the study's seed (the same α⁰ targets
 at every point: common random numbers, so that differences across the grid are the
-parameters' and not the sample's).  Its dataset is written, atomically, to
-``OUT.nc.parts/point-<i>.nc`` as soon as it is done, its checksum recorded beside it; a
-run that is killed and started again with the same command (``--force`` included) skips
-the points already there.  When every point is in,
-they are combined into ``OUT.nc`` (written atomically) and the parts are removed.
-Nothing depends on where a point ran (in-process, or on dask workers), so the dataset is
-the same either way.
+parameters' and not the sample's).  Its table of arrays is kept as soon as it is done
+and written, with the others that finished since, in a chunk of ``OUT.nc.parts``
+(:mod:`.store`: at most every couple of seconds, atomically, its checksum recorded); a
+run that is stopped and started again with the same command (``--force`` included)
+skips the points already there.  When every point is in, they make one dataset, written
+once to ``OUT.nc`` (atomically), and the parts are removed.  Nothing depends on where a
+point ran (in-process, or on dask workers), so the dataset is the same either way.
 """
 
 from __future__ import annotations
@@ -28,14 +28,16 @@ import numpy as np
 import xarray as xr
 
 from .._boundary import boundary
-from .._ensemble import ensemble
+from .._ensemble import ensemble_table
+from .._ensemble_dataset import Table
 from .._integrate import IntegrationWarning
-from .._loading import file_sha256, local_imports
+from .._loading import local_imports
 from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
 from ..engine.cache import function_fingerprint, library_fingerprint
 from .report import summary
 from .spec import Study, StudyError, load_study
+from .store import Manifest, Store, clear, stack
 from .theory import axis_units, for_study
 
 __all__ = ["run_study", "run_point", "combine"]
@@ -44,6 +46,8 @@ __all__ = ["run_study", "run_point", "combine"]
 #: the study dataset
 _VOLATILE = ("wall_sample_s", "wall_integrate_s", "wall_dataset_s", "created_at", "history",
              "threads", "stabdae_run_key", "grid_point")  # fmt: skip
+#: the volatile attributes that time a point's own work (its sampling and integration)
+_WORK = ("wall_sample_s", "wall_integrate_s")
 
 
 def axis_name(canon: str, all_names) -> str:
@@ -57,36 +61,37 @@ def axis_name(canon: str, all_names) -> str:
     return key
 
 
-def run_point(study: Study, values: dict, threads=None, progress=None) -> xr.Dataset:
+def run_point(study: Study, values: dict, threads=None, progress=None) -> Table:
     """The ensemble at one grid point, on the study's common sample grid (with
-    ``[search]``: the boundary search at that point)."""
+    ``[search]``: the boundary search at that point), as a table of arrays (with the
+    wall times of its sampling and integration, :data:`_VOLATILE`)."""
     s = study.setup(values)
     ens = study.ensemble
     if study.search is not None:
         return search_point(study, s, threads, progress)
     with warnings.catch_warnings():  # stopped members: the study's summary counts them
         warnings.simplefilter("ignore", IntegrationWarning)
-        ds = ensemble(study.model, s["law"], s["scheme"], s["tau"], s["t_end"],
-                      members=ens["members"], radius=tuple(ens["radius"]), seed=ens["seed"],
-                      save_dt=s["save_dt"], params=s["params"], epsilon=s["epsilon"],
-                      divergence=s["divergence"], block=ens["block"], threads=threads,
-                      progress=progress, states=ens["states"])  # fmt: skip
+        table = ensemble_table(study.model, s["law"], s["scheme"], s["tau"], s["t_end"],
+                               members=ens["members"], radius=tuple(ens["radius"]),
+                               seed=ens["seed"], save_dt=s["save_dt"], params=s["params"],
+                               epsilon=s["epsilon"], divergence=s["divergence"],
+                               block=ens["block"], threads=threads, progress=progress,
+                               states=ens["states"])  # fmt: skip
     if s["stride"] > 1:  # a step spans several samples: NaN between the steps
         stride = s["stride"]
-        t0 = float(ds.time[0])
-        nsave = (ds.sizes["time"] - 1) * stride + 1
-        times = t0 + (np.arange(nsave) / stride) * float(ds.time[1] - ds.time[0])
-        full = np.full((ds.sizes["trace"], nsave), np.nan, dtype=ds.residual_norm.dtype)
-        full[:, ::stride] = ds.residual_norm.values
-        attrs = ds.residual_norm.attrs
-        ds = ds.drop_vars("residual_norm").assign_coords(time=("time", times, ds.time.attrs))
-        ds["residual_norm"] = (("trace", "time"), full, attrs)
-    for key in _VOLATILE:
-        ds.attrs.pop(key, None)
-    return ds
+        time_ = table.coords["time"]
+        t = time_.values
+        nsave = (t.size - 1) * stride + 1
+        times = t[0] + (np.arange(nsave) / stride) * float(t[1] - t[0])
+        dims, norms, attrs = table.data["residual_norm"]
+        full = np.full((norms.shape[0], nsave), np.nan, dtype=norms.dtype)
+        full[:, ::stride] = norms
+        table.data["residual_norm"] = (dims, full, attrs)
+        table.coords["time"] = xr.Variable("time", times, time_.attrs)
+    return table
 
 
-def search_point(study: Study, s: dict, threads=None, progress=None) -> xr.Dataset:
+def search_point(study: Study, s: dict, threads=None, progress=None) -> Table:
     """The boundary search (:func:`stabdae.boundary`) at one grid point."""
     ens, search = study.ensemble, study.search
     ds = boundary(study.model, s["law"], s["scheme"], tau=search["tau"], rtol=search["rtol"],
@@ -96,9 +101,7 @@ def search_point(study: Study, s: dict, threads=None, progress=None) -> xr.Datas
                   params=s["params"], epsilon=s["epsilon"], divergence=s["divergence"],
                   block=ens["block"], threads=threads,
                   progress=progress if callable(progress) else False)  # fmt: skip
-    for key in _VOLATILE:
-        ds.attrs.pop(key, None)
-    return ds
+    return Table.from_dataset(ds)
 
 
 def _fingerprint(study: Study) -> str:
@@ -120,25 +123,6 @@ def _fingerprint(study: Study) -> str:
     for piece, fn in sorted({**model.functions, "energy": model.energy}.items()):
         h.update(f"{piece}={function_fingerprint(fn) if fn is not None else None}".encode())
     return h.hexdigest()
-
-
-def _part_ok(path: Path, index: int, manifest) -> str | None:
-    """Why the part file of grid point ``index`` cannot be used (None when it can): it
-    must open, carry this run's key and its own grid point, and match the checksum
-    recorded when it was written."""
-    try:
-        with xr.open_dataset(path) as part:
-            key, point = part.attrs.get("stabdae_run_key"), part.attrs.get("grid_point")
-            part.load()
-    except Exception as exc:  # a truncated, empty or foreign file: any reader error
-        return f"unreadable ({type(exc).__name__})"
-    if key != manifest.fingerprint:
-        return "written by another run"
-    if point != index:
-        return f"holds grid point {point}"
-    if not manifest.matches(path):
-        return "does not match its recorded checksum"
-    return None
 
 
 def output_path(study: Study, output=None) -> Path:
@@ -191,10 +175,10 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     stamp = _fingerprint(study)
     log(study.describe())
     existed = parts.exists() and any(p.name != "lock" for p in parts.iterdir())
-    if existed and _Manifest.read(parts) is None:  # before the lock: create nothing there
+    if existed and Manifest.read(parts) is None:  # before the lock: create nothing there
         raise FileExistsError(
             f"{parts} exists and was not written by a stabdae run (it has no readable "
-            f"{_Manifest.NAME}); it is left as it is: move it away or give another output "
+            f"{Manifest.NAME}); it is left as it is: move it away or give another output "
             "with -o"
         )
     try:
@@ -206,7 +190,7 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
     try:
         for orphan in out.parent.glob(f".{out.name}.*.tmp"):  # left by a killed write
             orphan.unlink(missing_ok=True)
-        old = _Manifest.read(parts) if existed else None
+        old = Manifest.read(parts) if existed else None
         if old is not None and old.fingerprint != stamp:
             if old.study == str(study.path.resolve()):
                 log(f"the study file, its model or the library changed since {parts} was "
@@ -218,63 +202,15 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
                     f"{parts} holds a run of a different study ({old.study}); pass --force "
                     "to discard it"
                 )
-            _clear(parts)
+            clear(parts)
             old = None
-        manifest = old or _Manifest(parts, stamp, str(study.path.resolve()))
+        manifest = old or Manifest(parts, stamp, str(study.path.resolve()))
         return _run_locked(study, out, parts, manifest, workers, scheduler, progress,
                            threads, log)  # fmt: skip
     finally:
         lock.unlink(missing_ok=True)
         if parts.exists() and not any(parts.iterdir()):
             parts.rmdir()
-
-
-class _Manifest:
-    """``OUTPUT.parts/study.json``: the run key, the study file (resolved) and the SHA-256
-    of every part as it was written, so that a part altered afterwards is computed again.
-    Only the process that runs the study writes it (dask workers return datasets)."""
-
-    NAME = "study.json"
-
-    def __init__(self, parts: Path, fingerprint: str, study: str, digests=None):
-        self.parts, self.fingerprint, self.study = parts, fingerprint, study
-        self.digests = dict(digests or {})
-
-    @classmethod
-    def read(cls, parts: Path):
-        """The manifest in ``parts``, or None when there is none a stabdae run wrote."""
-        try:
-            raw = json.loads((parts / cls.NAME).read_text())
-            return cls(parts, str(raw["fingerprint"]), str(raw["study"]),
-                       {str(k): str(v) for k, v in raw.get("parts", {}).items()})  # fmt: skip
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            return None
-
-    def save(self) -> None:
-        text = json.dumps({"fingerprint": self.fingerprint, "study": self.study,
-                           "parts": self.digests}, sort_keys=True)  # fmt: skip
-        tmp = self.parts / f".{self.NAME}.tmp"
-        tmp.write_text(text)
-        os.replace(tmp, self.parts / self.NAME)  # a kill leaves the old or the new one
-
-    def write(self, ds: xr.Dataset, index: int) -> None:
-        """Write grid point ``index``'s part and record its checksum."""
-        path = self.parts / f"point-{index}.nc"
-        write_netcdf(_keyed(ds, index, self.fingerprint), path)
-        self.digests[path.name] = file_sha256(path)
-        self.save()
-
-    def matches(self, path: Path) -> bool:
-        return self.digests.get(path.name) == file_sha256(path)
-
-
-def _clear(parts: Path) -> None:
-    """Remove what stabdae wrote in ``parts`` (its points, manifest and temporary files),
-    nothing else."""
-    for pattern in ("point-*.nc", _Manifest.NAME, ".point-*.tmp", f".{_Manifest.NAME}.tmp"):
-        for path in parts.glob(pattern):
-            if path.is_file():
-                path.unlink()
 
 
 def _lock(parts: Path) -> Path:
@@ -316,38 +252,45 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
                 log) -> Path:  # fmt: skip
     manifest.save()
     points = list(study.points())
-    todo = []
-    for i, (_, values) in enumerate(points):
-        part = parts / f"point-{i}.nc"
-        if part.exists():
-            why = _part_ok(part, i, manifest)
-            if why is None:
-                continue
-            log(f"grid point {i}: {part.name} {why}: computing it again")
-            part.unlink()
-        todo.append((i, values))
+    store = Store(manifest)
+    store.resume(len(points), log)
+    todo = [(i, values) for i, (_, values) in enumerate(points) if i not in store.tables]
     if len(todo) < len(points):
         log(f"resuming: {len(points) - len(todo)} of {len(points)} grid points already done")
     start = time.perf_counter()
     bar = _Progress(len(points), len(points) - len(todo), _work_per_point(study), progress)
+    work = [0.0]  # the points' sampling and integration, in seconds
+
+    def done(i: int, table: Table) -> None:
+        work[0] += sum(float(table.attrs.get(k, 0.0)) for k in _WORK)
+        for key in _VOLATILE:
+            table.attrs.pop(key, None)
+        store.add(i, table)
+        bar.point_done()
+
     try:
         if workers or scheduler:
-            _run_dask(study, todo, manifest, workers, scheduler, bar)
+            _run_dask(study, todo, done, workers, scheduler)
         else:
             for i, values in todo:
                 report = bar.note if study.search is not None else bar.members
-                manifest.write(run_point(study, values, threads=threads, progress=report), i)
-                bar.point_done()
-    finally:
+                done(i, run_point(study, values, threads=threads, progress=report))
+    finally:  # the points done are written whatever stopped the run (a kill aside)
         bar.close()
-    ds = combine(study, parts, len(points))
+        store.flush()
+    ds = combine(study, [store.tables[i] for i in range(len(points))])
     if not study.setup()["law"].is_constant and study.search is None:
         ds = _with_path_theory(study, ds)
     ds.attrs["wall_run_s"] = time.perf_counter() - start
     write_netcdf(ds, out)
-    _clear(parts)
+    clear(parts)
     log(summary(ds))
-    log(f"dataset written to {out}")
+    wall = time.perf_counter() - start
+    timing = ""
+    if todo and not (workers or scheduler):  # (on workers, the times are theirs)
+        timing = (f" ({len(todo)} grid points in {wall:.2f} s: sampling and integration "
+                  f"{work[0]:.2f} s, the rest {wall - work[0]:.2f} s)")  # fmt: skip
+    log(f"dataset written to {out}{timing}")
     return out
 
 
@@ -361,13 +304,7 @@ def _with_path_theory(study: Study, ds: xr.Dataset) -> xr.Dataset:
     return ds.assign({v: th[v].assign_coords({d: ds[d] for d in th[v].dims}) for v in keep})
 
 
-def _keyed(ds: xr.Dataset, index: int, stamp: str) -> xr.Dataset:
-    """A grid point's dataset marked with its index and the run key, as its part file."""
-    ds.attrs.update(stabdae_run_key=stamp, grid_point=index)
-    return ds
-
-
-def _run_dask(study, todo, manifest, workers, scheduler, bar):
+def _run_dask(study, todo, done, workers, scheduler):
     from dask.distributed import Client, LocalCluster, as_completed
 
     if scheduler:
@@ -386,9 +323,7 @@ def _run_dask(study, todo, manifest, workers, scheduler, bar):
         futures = {client.submit(_remote_point, path, members, values, pure=False): i
                    for i, values in todo}  # fmt: skip
         for fut in as_completed(futures):
-            i = futures[fut]
-            manifest.write(fut.result(), i)
-            bar.point_done()
+            done(futures[fut], fut.result())
     finally:
         client.close()
         if cluster is not None:
@@ -401,32 +336,18 @@ def _remote_point(path, members, values):
     return run_point(study, values, threads=1)
 
 
-def combine(study: Study, parts: Path, npoints: int) -> xr.Dataset:
-    """The study dataset from its per-point parts: every variable gains the sweep axes."""
+def combine(study: Study, tables: list[Table]) -> xr.Dataset:
+    """The study dataset from its grid points' tables (C order over the sweep axes):
+    every variable gains the sweep axes."""
     names = list(study.axes)
-    pts = []
-    for i in range(npoints):
-        with xr.open_dataset(parts / f"point-{i}.nc") as f:
-            pts.append(f.load())
-    if "probe" in pts[0].dims:  # searches take different numbers of probes: pad with NaN
-        size = max(p.sizes["probe"] for p in pts)
-        pts = [p.reindex(probe=np.arange(size)) for p in pts]
-    first = pts[0]
+    dims = [axis_name(n, names) for n in names]
     if not names:
-        ds = first
+        ds = tables[0].to_dataset()
+    elif any("probe" in _dims_of(t) for t in tables):
+        ds = _combine_searches(study, [t.to_dataset() for t in tables], dims)
     else:
-        dims = [axis_name(n, names) for n in names]
-        stacked = xr.concat(pts, dim="point", coords="minimal", compat="override",
-                            combine_attrs="drop_conflicts", join="override")  # fmt: skip
-        index = np.array([idx for idx, _ in study.points()])
-        ds = stacked.assign_coords(
-            {d: ("point", study.axes[n][index[:, k]]) for k, (n, d) in enumerate(zip(names, dims))}
-        )
-        if len(dims) == 1:
-            ds = ds.swap_dims(point=dims[0])
-        else:
-            ds = ds.set_index(point=dims).unstack("point")
-        ds = ds.transpose(*dims, ...)
+        ds = stack(tables, {d: study.axes[n] for n, d in zip(names, dims)})
+    if names:
         for n, d in zip(names, dims):
             ds[d].attrs.update(long_name=f"swept {n}", units=axis_units(n))
         for n in names:  # a swept value is a coordinate now, not an attribute
@@ -437,9 +358,32 @@ def combine(study: Study, parts: Path, npoints: int) -> xr.Dataset:
     ds.attrs["swept"] = ", ".join(names) if names else "nothing"
     ds.attrs["created_at"] = utc_now()
     what = "boundary searches" if study.search is not None else "grid points"
-    append_history(ds.attrs, f"stabdae run {study.path.name}: {npoints} {what} of "
+    append_history(ds.attrs, f"stabdae run {study.path.name}: {len(tables)} {what} of "
                    f"{study.ensemble['members']} members combined")  # fmt: skip
     return ds
+
+
+def _dims_of(table: Table) -> set:
+    return {d for dims, _, _ in table.data.values()
+            for d in ((dims,) if isinstance(dims, str) else dims)}  # fmt: skip
+
+
+def _combine_searches(study: Study, pts: list[xr.Dataset], dims: list[str]) -> xr.Dataset:
+    """Boundary searches take different numbers of probes: padded with NaN to the most,
+    then concatenated along the grid."""
+    size = max(p.sizes["probe"] for p in pts)
+    pts = [p.reindex(probe=np.arange(size)) for p in pts]
+    stacked = xr.concat(pts, dim="point", coords="minimal", compat="override",
+                        combine_attrs="drop_conflicts", join="override")  # fmt: skip
+    index = np.array([idx for idx, _ in study.points()])
+    ds = stacked.assign_coords(
+        {d: ("point", study.axes[n][index[:, k]]) for k, (n, d) in enumerate(zip(study.axes, dims))}
+    )
+    if len(dims) == 1:
+        ds = ds.swap_dims(point=dims[0])
+    else:
+        ds = ds.set_index(point=dims).unstack("point")
+    return ds.transpose(*dims, ...)
 
 
 def _work_per_point(study: Study) -> int:

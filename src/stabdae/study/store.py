@@ -1,0 +1,365 @@
+"""A study's store: the grid points' tables (:class:`~stabdae._ensemble_dataset.Table`),
+kept in memory as they finish and written to ``OUT.nc.parts`` in chunks, from which a run
+that was stopped resumes; and the one dataset made of them all (:func:`combine`).
+
+Why chunks of plain arrays and not a NetCDF file per grid point (or a zarr store written
+region by region): a grid point's NetCDF part cost about 100 ms to write and 50 ms to
+read back (HDF5's cost per variable, ~60 variables), more than its ensemble on the main
+study; a store written region by region needs every writer to reach one file system,
+which a dask cluster's workers need not share with the process that runs the study.
+Here only that process writes: the workers return their tables, and a chunk is written
+at most every :data:`FLUSH_SECONDS` (and when the run stops, for any reason but a kill)
+with ``numpy.savez``, atomically (a temporary file renamed into place), its SHA-256 and
+grid points recorded in the manifest (``study.json``), which is itself replaced
+atomically.  A kill loses at most the grid points since the last chunk; a chunk whose
+bytes differ from the recorded checksum, or that cannot be read, is computed again.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .._ensemble_dataset import Table
+from .._loading import file_sha256
+from .._schema import deferred_interrupt
+
+#: the longest time finished grid points wait in memory before they are written (the
+#: environment variable ``STABDAE_FLUSH_SECONDS`` sets another; 0: a chunk per point)
+FLUSH_SECONDS = 2.0
+
+
+def _flush_seconds() -> float:
+    text = os.environ.get("STABDAE_FLUSH_SECONDS")
+    if text is None:
+        return FLUSH_SECONDS
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value >= 0.0:
+        raise ValueError(f"STABDAE_FLUSH_SECONDS={text!r}: expected a number of seconds ≥ 0")
+    return value
+
+
+class Manifest:
+    """``OUTPUT.parts/study.json``: the run key, the study file (resolved) and, for every
+    chunk written, its SHA-256 and grid points, so that a chunk altered afterwards is
+    computed again.  Only the process that runs the study writes it."""
+
+    NAME = "study.json"
+
+    def __init__(self, parts: Path, fingerprint: str, study: str, chunks=None):
+        self.parts, self.fingerprint, self.study = parts, fingerprint, study
+        self.chunks = dict(chunks or {})
+
+    @classmethod
+    def read(cls, parts: Path):
+        """The manifest in ``parts``, or None when there is none a stabdae run wrote."""
+        try:
+            raw = json.loads((parts / cls.NAME).read_text())
+            chunks = {str(k): {"sha256": str(v["sha256"]),
+                               "points": [int(i) for i in v["points"]]}
+                      for k, v in raw.get("chunks", {}).items()}  # fmt: skip
+            return cls(parts, str(raw["fingerprint"]), str(raw["study"]), chunks)
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return None
+
+    def save(self) -> None:
+        text = json.dumps({"fingerprint": self.fingerprint, "study": self.study,
+                           "chunks": self.chunks}, sort_keys=True)  # fmt: skip
+        tmp = self.parts / f".{self.NAME}.tmp"
+        tmp.write_text(text)
+        os.replace(tmp, self.parts / self.NAME)  # a kill leaves the old or the new one
+
+    def points_done(self) -> int:
+        return sum(len(c["points"]) for c in self.chunks.values())
+
+
+#: what a run writes in ``OUTPUT.parts`` (and :func:`clear` removes; ``point-*.nc``: the
+#: parts of earlier versions, one NetCDF file per grid point)
+_OURS = ("chunk-*.npz", ".chunk-*.tmp", Manifest.NAME, f".{Manifest.NAME}.tmp", "point-*.nc",
+         ".point-*.tmp")  # fmt: skip
+
+
+def clear(parts: Path) -> None:
+    """Remove what stabdae wrote in ``parts`` (its chunks, manifest and temporary files),
+    nothing else."""
+    for pattern in _OURS:
+        for path in parts.glob(pattern):
+            if path.is_file():
+                path.unlink()
+
+
+class Store:
+    """The finished grid points' tables, by grid point, and the chunks they are written
+    in (:data:`FLUSH_SECONDS`)."""
+
+    def __init__(self, manifest: Manifest):
+        self.manifest = manifest
+        self.tables: dict[int, Table] = {}
+        self._pending: list[int] = []
+        self._flushed = time.monotonic()
+        self._every = _flush_seconds()
+        numbers = [_chunk_number(name) for name in manifest.chunks]
+        self._next = max(numbers, default=-1) + 1
+
+    def resume(self, npoints: int, log) -> None:
+        """Read the chunks the manifest records; a chunk that cannot be used is removed
+        (its grid points are computed again, and ``log`` says why), and so is any chunk
+        file the manifest does not record (written when a kill came before the
+        manifest)."""
+        parts = self.manifest.parts
+        for path in parts.glob("chunk-*.npz"):
+            if path.name not in self.manifest.chunks:
+                path.unlink()
+        for name, entry in sorted(self.manifest.chunks.items()):
+            path = parts / name
+            why = None
+            if not path.exists():
+                why = "is missing"
+            elif file_sha256(path) != entry["sha256"]:
+                why = "does not match its recorded checksum"
+            else:
+                try:
+                    tables = _unpack(path, self.manifest.fingerprint)
+                except Exception as exc:  # any reader error: a damaged or foreign file
+                    why = f"unreadable ({type(exc).__name__}: {exc})"
+                else:
+                    if sorted(tables) != entry["points"] or max(tables, default=0) >= npoints:
+                        why = "holds other grid points than recorded"
+            if why is not None:
+                points = ", ".join(map(str, entry["points"]))
+                log(f"grid points {points}: {name} {why}: computing them again")
+                path.unlink(missing_ok=True)
+                del self.manifest.chunks[name]
+                continue
+            self.tables.update(tables)
+        self.manifest.save()
+
+    def add(self, index: int, table: Table) -> None:
+        """Grid point ``index`` is done: kept, and written with the others waiting once
+        the last chunk is :data:`FLUSH_SECONDS` old."""
+        self.tables[index] = table
+        self._pending.append(index)
+        if time.monotonic() - self._flushed >= self._every:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the grid points waiting as one chunk and record it."""
+        self._flushed = time.monotonic()
+        if not self._pending:
+            return
+        with deferred_interrupt():  # a chunk and its record, whole or not at all
+            points = sorted(self._pending)
+            buffer = io.BytesIO()
+            np.savez(buffer, **_pack({i: self.tables[i] for i in points},
+                                     self.manifest.fingerprint))  # fmt: skip
+            data = buffer.getvalue()
+            name = f"chunk-{self._next}.npz"
+            parts = self.manifest.parts
+            tmp = parts / f".{name}.tmp"
+            tmp.write_bytes(data)
+            os.replace(tmp, parts / name)
+            self.manifest.chunks[name] = {"sha256": _sha256(data), "points": points}
+            self.manifest.save()
+            self._next += 1
+            self._pending.clear()
+
+
+def _chunk_number(name: str) -> int:
+    try:
+        return int(name.removeprefix("chunk-").removesuffix(".npz"))
+    except ValueError:
+        return -1
+
+
+def _sha256(data: bytes) -> str:
+    import hashlib
+
+    return hashlib.sha256(data).hexdigest()
+
+
+# --------------------------------------------------------------------- chunk files
+def _pack(tables: dict[int, Table], fingerprint: str) -> dict:
+    """The arrays of a chunk: each variable's (``d/<name>``) and coordinate's
+    (``c/<name>``) values of all its tables stacked along a first axis (one array per
+    name: ``numpy.savez`` costs about 0.1 ms per array), or per table (``<k>/d/<name>``,
+    ``k`` the table's place in the chunk) where their shapes or types differ; and
+    ``meta``: the run key, the grid points and, per table, the dimensions and attributes
+    (JSON, as bytes)."""
+    arrays, meta = {}, {"fingerprint": fingerprint, "points": list(tables), "tables": []}
+    group = list(tables.values())
+    for kind, items in (("d", lambda t: {k: v[1] for k, v in t.data.items()}),
+                        ("c", lambda t: {k: v.values for k, v in t.coords.items()})):
+        columns: dict[str, list] = {}
+        for table in group:
+            for name, values in items(table).items():
+                columns.setdefault(name, []).append(_plain(values))
+        for name, column in columns.items():
+            if len(column) == len(group) and len({(a.shape, a.dtype.str) for a in column}) == 1:
+                arrays[f"{kind}/{name}"] = np.stack(column)
+            else:
+                for k, a in enumerate(column):
+                    arrays[f"{k}/{kind}/{name}"] = a
+    # each variable's attributes once (the first table's), and per table only those that
+    # differ from them (the JSON of every table's own was most of a chunk's cost)
+    shared = {"d": {k: v[2] for k, v in group[0].data.items()},
+              "c": {k: dict(v.attrs) for k, v in group[0].coords.items()}}  # fmt: skip
+    meta["shared"] = {kind: {k: _jsonable(a) for k, a in d.items()} for kind, d in shared.items()}
+    meta["shared_attrs"] = _jsonable(group[0].attrs)
+
+    def own(kind, name, attrs):
+        return None if _same_attrs(shared[kind].get(name), attrs) else _jsonable(attrs)
+
+    for table in group:
+        meta["tables"].append({
+            "data": {name: [_dims(dims), own("d", name, attrs)]
+                     for name, (dims, _, attrs) in table.data.items()},
+            "coords": {name: [list(var.dims), own("c", name, dict(var.attrs))]
+                       for name, var in table.coords.items()},
+            "attrs": {k: _jsonable(v) for k, v in table.attrs.items()
+                      if not (k in group[0].attrs and _same(group[0].attrs[k], v))},
+            "absent": [k for k in group[0].attrs if k not in table.attrs],
+        })  # fmt: skip
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    return arrays
+
+
+def _unpack(path: Path, fingerprint: str) -> dict[int, Table]:
+    """The tables of a chunk written by :func:`_pack` under the run key ``fingerprint``."""
+    with np.load(path, allow_pickle=False) as npz:
+        meta = json.loads(npz["meta"].tobytes().decode())
+        if meta["fingerprint"] != fingerprint:
+            raise ValueError("written by another run")
+        stacked = {key: npz[key] for key in npz.files if key[:2] in ("d/", "c/")}
+
+        def values(kind, name, k):
+            key = f"{kind}/{name}"
+            return np.asarray(stacked[key][k]) if key in stacked else npz[f"{k}/{key}"]
+
+        shared = meta["shared"]
+
+        def attrs_of(kind, name, own):
+            return _from_json(shared[kind][name] if own is None else own)
+
+        out = {}
+        for k, (i, entry) in enumerate(zip(meta["points"], meta["tables"])):
+            data = {name: (tuple(dims), values("d", name, k), attrs_of("d", name, own))
+                    for name, (dims, own) in entry["data"].items()}  # fmt: skip
+            coords = {name: xr.Variable(tuple(dims), values("c", name, k),
+                                        attrs_of("c", name, own))
+                      for name, (dims, own) in entry["coords"].items()}  # fmt: skip
+            attrs = {**_from_json(meta["shared_attrs"]),
+                     **{k: _from_json(v) for k, v in entry["attrs"].items()}}
+            for key in entry["absent"]:
+                del attrs[key]
+            out[int(i)] = Table(data, coords, attrs)
+    return out
+
+
+def _dims(dims) -> list:
+    return [dims] if isinstance(dims, str) else list(dims)
+
+
+def _plain(values) -> np.ndarray:
+    """``values`` as an array ``numpy.load`` reads without pickle (text as unicode)."""
+    arr = np.asarray(values)
+    return arr.astype(str) if arr.dtype.hasobject else arr
+
+
+def _jsonable(value):
+    """Attribute values as JSON, numpy types tagged with their dtype so that they come
+    back as they were (floats in JSON are exact: Python writes the shortest repr that
+    reads back to the same double)."""
+    if isinstance(value, dict):
+        return {"__dict__": {str(k): _jsonable(v) for k, v in value.items()}}
+    if isinstance(value, np.ndarray):
+        return {"__ndarray__": value.tolist(), "dtype": value.dtype.str}
+    if isinstance(value, np.generic):
+        return {"__scalar__": value.item(), "dtype": value.dtype.str}
+    if isinstance(value, (list, tuple)):
+        return {"__list__": [_jsonable(v) for v in value], "tuple": isinstance(value, tuple)}
+    return value
+
+
+def _from_json(value):
+    if isinstance(value, dict):
+        if "__dict__" in value:
+            return {k: _from_json(v) for k, v in value["__dict__"].items()}
+        if "__ndarray__" in value:
+            return np.array(value["__ndarray__"], dtype=np.dtype(value["dtype"]))
+        if "__scalar__" in value:
+            return np.dtype(value["dtype"]).type(value["__scalar__"])
+        if "__list__" in value:
+            items = [_from_json(v) for v in value["__list__"]]
+            return tuple(items) if value["tuple"] else items
+    return value
+
+
+# --------------------------------------------------------------------- the dataset
+def _same(a, b) -> bool:
+    """Whether two attribute values are equal (arrays element by element, NaN equal to
+    NaN), as xarray's ``drop_conflicts`` compares them."""
+    if a is b:
+        return True
+    if type(a) is type(b) and isinstance(a, (str, int, bool)):
+        return a == b
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b or (a != a and b != b)
+    try:
+        return bool(np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True))
+    except TypeError:  # not numbers
+        try:
+            return bool(np.all(np.asarray(a) == np.asarray(b)))
+        except Exception:  # different shapes or types
+            return False
+
+
+def _same_attrs(a: dict | None, b: dict) -> bool:
+    return a is not None and a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+
+
+def common_attrs(many: list[dict]) -> dict:
+    """The attributes that no two of ``many`` give different values (xarray's
+    ``combine_attrs="drop_conflicts"``): each name's first value, unless another differs."""
+    out, dropped = {}, set()
+    for attrs in many:
+        for key, val in attrs.items():
+            if key in dropped:
+                continue
+            if key not in out:
+                out[key] = val
+            elif not _same(out[key], val):
+                del out[key]
+                dropped.add(key)
+    return out
+
+
+def stack(tables: list[Table], axes: dict[str, np.ndarray]) -> xr.Dataset:
+    """One dataset of the grid's tables (C order over ``axes``, dimension name → values):
+    every variable gains the axes as its leading dimensions; the coordinates are the first
+    table's, the attributes those all tables share (:func:`common_attrs`).  Two axes or
+    more are sorted by value, as xarray's unstacking of the grid does."""
+    dims = tuple(axes)
+    shape = tuple(len(v) for v in axes.values())
+    first = tables[0]
+    data = {}
+    for name, (vdims, _, _) in first.data.items():
+        column = np.stack([np.asarray(t.data[name][1]) for t in tables])
+        attrs = common_attrs([t.data[name][2] for t in tables])
+        data[name] = xr.Variable(dims + tuple(_dims(vdims)),
+                                 column.reshape(shape + column.shape[1:]), attrs)  # fmt: skip
+    coords = dict(first.coords)
+    for d, values in axes.items():
+        coords[d] = xr.Variable(d, np.asarray(values))
+    ds = xr.Dataset(data, coords=coords, attrs=common_attrs([t.attrs for t in tables]))
+    if len(dims) > 1 and any(np.any(np.diff(np.asarray(v)) <= 0) for v in axes.values()):
+        ds = ds.sortby(list(dims))
+    return ds
