@@ -528,6 +528,28 @@ def test_progress_counts_every_member_of_every_point(capsys):
     assert capsys.readouterr().err == ""
 
 
+def test_progress_rate_and_time_left_start_after_compiling(capsys):
+    """The first chunk of members waits for the kernels to compile (seconds to minutes):
+    the bar's clock restarts when it is done, so that the rate and the time left are
+    those of the integration (right after compiling the bar showed hours left)."""
+    from stabdae.study.run import _Progress
+
+    bar = _Progress(2, 0, 100, True)
+    time.sleep(0.6)  # "compiling"
+    bar.members(10, 100)
+    assert bar._bar.n == 10 and bar._bar.format_dict["elapsed"] < 0.3
+    time.sleep(0.1)
+    bar.members(30, 100)
+    fmt = bar._bar.format_dict
+    assert fmt["n"] == 30 and fmt["initial"] == 10
+    rate = (fmt["n"] - fmt["initial"]) / fmt["elapsed"]
+    assert rate > 60  # 20 members in about 0.1 s, not in the 0.7 s since the start
+    bar.members(100, 100)
+    bar.point_done()
+    bar.close()
+    assert "kernels ready" in capsys.readouterr().err
+
+
 def test_ctrl_c_during_a_write_takes_effect_once_the_file_is_written(tmp_path, monkeypatch):
     """SIGINT arriving while a dataset (a study's part, its final file) is being written:
     the file is finished, then KeyboardInterrupt is raised.  Interrupted inside the write,

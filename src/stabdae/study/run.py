@@ -431,6 +431,14 @@ class _Progress:
             if self._bar is not None:
                 seconds = time.perf_counter() - self._started
                 self._bar.set_description(f"stabdae run (kernels ready in {seconds:.0f} s)")
+                # the rate and time left from here on: the clock restarts, and what is
+                # done so far (the first chunk, which waited for the compiler) is its start
+                start = self._bar.n + done - self._last
+                self._bar.reset(total=self._bar.total)
+                self._bar.n = self._bar.last_print_n = self._bar.initial = start
+                self._bar.refresh()
+                self._last = done
+                return
         if self._bar is not None:
             self._bar.update(done - self._last)
             self._last = done
