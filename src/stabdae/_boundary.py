@@ -37,7 +37,7 @@ from ._measures import (
     VERDICTS,
     ensemble_verdict,
 )
-from ._schema import provenance, schema_variable, variable
+from ._schema import cf_dataset, provenance, schema_variable, variable
 from .engine.ensemble.block import BLOCK
 
 __all__ = ["boundary", "floor_limit"]
@@ -399,4 +399,4 @@ def _dataset(model, p, law, scheme, r) -> xr.Dataset:
                  epsilon=r["epsilon"], bracket_low=r["bracket"][0],
                  bracket_high=r["bracket"][1])  # fmt: skip
     coords = {"probe": variable("probe", np.arange(len(probes)), "probe index", "1")}
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return cf_dataset(data, coords=coords, attrs=attrs)

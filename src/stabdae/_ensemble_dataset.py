@@ -22,7 +22,15 @@ from . import _measures, theory
 from ._codes import Status
 from ._integrate import IntegrationWarning
 from ._laws import Theorem5
-from ._schema import COUNTS, SINGLE_PRECISION, model_coords, provenance, schema_entry, variable
+from ._schema import (
+    COUNTS,
+    SINGLE_PRECISION,
+    cf_dataset,
+    model_coords,
+    provenance,
+    schema_entry,
+    variable,
+)
 from .engine import decay
 
 
@@ -38,7 +46,7 @@ class Table:
     attrs: dict = field(default_factory=dict)
 
     def to_dataset(self) -> xr.Dataset:
-        return xr.Dataset(self.data, coords=self.coords, attrs=self.attrs)
+        return cf_dataset(self.data, coords=self.coords, attrs=self.attrs)
 
     @classmethod
     def from_dataset(cls, ds: xr.Dataset) -> Table:

@@ -552,7 +552,7 @@ def trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, r
     status = Status(status)
     attrs.update(status=int(status), status_name=status.name.lower(), steps_completed=done)
     attrs.update({f"status_{k}": v for k, v in flag_attrs(Status).items()})
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return cf_dataset(data, coords=coords, attrs=attrs)
 
 
 def write_netcdf(ds: xr.Dataset, path, *, compress: int = 4, overwrite: bool = True) -> Path:
@@ -587,6 +587,21 @@ def deferred_interrupt():
                 previous(signal.SIGINT, None)  # Python's own handler raises KeyboardInterrupt
             elif previous == signal.SIG_DFL:
                 raise KeyboardInterrupt
+
+
+def cf_dataset(data, coords=None, attrs=None) -> xr.Dataset:
+    """``xarray.Dataset(data, coords, attrs)`` as CF wants it on disk, so that its own
+    ``to_netcdf`` writes a file CF checkers accept: each code variable's ``flag_values``
+    an array of the variable's own type (CF 3.5; also what reading the file back gives),
+    and no ``_FillValue`` on coordinate variables (CF 2.5.1: a coordinate has no missing
+    values; xarray gives floats one by default)."""
+    ds = xr.Dataset(data, coords=coords, attrs=attrs)
+    for name, var in ds.variables.items():
+        if "flag_values" in var.attrs and var.dtype.kind in "iu":
+            var.attrs["flag_values"] = np.asarray(var.attrs["flag_values"], dtype=var.dtype)
+        if name in ds.coords and var.dtype.kind in "fiu":
+            var.encoding["_FillValue"] = None
+    return ds
 
 
 def _cf_encoded(ds: xr.Dataset) -> xr.Dataset:

@@ -47,7 +47,7 @@ from numba import njit
 
 from ._laws import Law, Theorem5, as_law
 from ._model import Model
-from ._schema import component_coords, provenance, schema_variable, variable
+from ._schema import cf_dataset, component_coords, provenance, schema_variable, variable
 from ._schemes import as_scheme
 
 __all__ = [
@@ -709,7 +709,7 @@ def along_path(model: Model, law, scheme, trajectory: xr.Dataset, *, params=None
                        "trajectory", tau=tau)  # fmt: skip
     coords = {"step": variable("step", np.arange(N), "step index k", "1"),
               "time": variable("step", ts[:N], "time", "s"), **component_coords(model)}  # fmt: skip
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return cf_dataset(data, coords=coords, attrs=attrs)
 
 
 def _A_tilde(law: Law, model: Model, x, t, p) -> np.ndarray:

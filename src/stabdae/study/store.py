@@ -28,7 +28,7 @@ import xarray as xr
 
 from .._ensemble_dataset import Table
 from .._loading import file_sha256
-from .._schema import deferred_interrupt
+from .._schema import cf_dataset, deferred_interrupt
 
 #: the longest time finished grid points wait in memory before they are written (the
 #: environment variable ``STABDAE_FLUSH_SECONDS`` sets another; 0: a chunk per point)
@@ -359,7 +359,7 @@ def stack(tables: list[Table], axes: dict[str, np.ndarray]) -> xr.Dataset:
     coords = dict(first.coords)
     for d, values in axes.items():
         coords[d] = xr.Variable(d, np.asarray(values))
-    ds = xr.Dataset(data, coords=coords, attrs=common_attrs([t.attrs for t in tables]))
+    ds = cf_dataset(data, coords=coords, attrs=common_attrs([t.attrs for t in tables]))
     if len(dims) > 1 and any(np.any(np.diff(np.asarray(v)) <= 0) for v in axes.values()):
         ds = ds.sortby(list(dims))
     return ds

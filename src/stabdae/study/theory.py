@@ -14,7 +14,7 @@ import xarray as xr
 
 from .._ensemble import sample_perturbations
 from .._integrate import integrate
-from .._schema import component_coords, provenance, schema_variable, variable
+from .._schema import cf_dataset, component_coords, provenance, schema_variable, variable
 from ..theory import (
     CONDITIONS,
     along_path,
@@ -103,4 +103,4 @@ def for_study(study, *, path_steps: int = 2000) -> xr.Dataset:
     attrs = provenance(model, None, setup["law"], setup["scheme"],
                        f"stabdae theory {study.path.name}: the theorems over the grid")
     attrs["study"] = str(study.path)
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return cf_dataset(data, coords=coords, attrs=attrs)
