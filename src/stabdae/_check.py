@@ -13,7 +13,17 @@ sparsity   every non-zero of mass, f_q, h_q, h_v inside the pattern the model
            declared or detected (the sparse right-hand side reads nothing else)
 ========== ==============================================================
 
-A piece fails when ``max |analytic − finite difference| > rtol · max(1, max |fd|, max |analytic|)``.
+A piece fails when ``max |analytic − finite difference| > rtol · max(max |fd|, max
+|analytic|) + noise``: relative to the piece's own size at that state (a term that is small
+in the model's units is checked as strictly as a large one), ``noise`` the finite
+differences' own roundoff, ``100 ε^{2/3}`` times the size of the values differenced.
+
+The states: the reference state, and ``states`` random ones whose coordinates lie within
+``radius`` (relative) of the reference's and whose velocities are drawn at the scale of
+the motion: ``velocity`` per second (default: the reference's largest speed, or, at
+rest, its largest coordinate per second), around the reference's.  A velocity-squared
+term of ``f_accel`` is then of the size of the others, and a wrong sign in it shows at
+every random state (at a reference at rest it is zero whatever its sign).
 """
 
 from __future__ import annotations
@@ -109,7 +119,27 @@ def _scalar_derivative(fun, s: float) -> np.ndarray:
     return (fun(s + h) - fun(s - h)) / (2 * h)
 
 
-def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rtol=1e-6):
+#: the finite differences' roundoff allowed: this many ``ε^{2/3}`` times the size of the
+#: values differenced (central differences with ``h = ε^{1/3}``: ``ε |F| / h``)
+_NOISE = 100.0 * _EPS3 * _EPS3
+
+
+def velocity_scale(x_ref: np.ndarray, n: int, velocity=None) -> np.ndarray:
+    """Each velocity component's scale for the check's random states: ``velocity`` (a
+    number or one per coordinate) where given, else the reference's largest speed, or at
+    rest its largest coordinate per second (1 where both are zero)."""
+    if velocity is not None:
+        scale = np.broadcast_to(np.asarray(velocity, dtype=float), (n,)).copy()
+        if not (np.all(np.isfinite(scale)) and np.all(scale >= 0)):
+            raise ValueError(f"check: velocity must be finite and ≥ 0, got {velocity!r}")
+        return scale
+    speed = float(np.max(np.abs(x_ref[n:]), initial=0.0))
+    size = float(np.max(np.abs(x_ref[:n]), initial=0.0))
+    return np.full(n, speed if speed > 0 else (size if size > 0 else 1.0))
+
+
+def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rtol=1e-6,
+                velocity=None):  # fmt: skip
     """Compare every derivative piece of ``model`` with finite differences.
 
     Parameters
@@ -119,11 +149,15 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
     states : int
         Number of random states near the reference state, checked besides it.
     radius : float
-        Relative size of the random displacement of those states.
+        Relative size of the random displacement of those states' coordinates.
+    velocity : float or array (n,), optional
+        Scale of those states' velocities, per second (default: the reference state's
+        largest speed, or its largest coordinate when it is at rest).
     seed : int
         Seed of the random states.
     rtol : float
-        Tolerance, relative to ``max(1, |derivative|)``.
+        Tolerance, relative to each piece's size at the state (plus the finite
+        differences' roundoff).
 
     Returns
     -------
@@ -136,9 +170,13 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
     x_ref = model.reference_state(p)
     xs = [x_ref]
     ts = [model.t0]
+    n = model.n
     scale = np.maximum(1.0, np.abs(x_ref))
+    vscale = velocity_scale(x_ref, n, velocity)
     for _ in range(states):
-        xs.append(x_ref + radius * scale * rng.standard_normal(x_ref.shape))
+        x = x_ref + radius * scale * rng.standard_normal(x_ref.shape)
+        x[n:] = x_ref[n:] + vscale * rng.standard_normal(n)
+        xs.append(x)
         ts.append(model.t0 + (rng.uniform(0.0, 1.0) if model.time_dependent else 0.0))
     report = CheckReport(model.name, rtol, np.array(xs))
     for i, (x, t) in enumerate(zip(xs, ts)):
@@ -155,12 +193,17 @@ def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> N
     n, ev = model.n, model.evaluate
     q, v = x[:n], x[n:]
 
-    def add(piece, analytic, fd, detail=""):
+    def add(piece, analytic, fd, values, detail=""):
+        """A row: ``values`` the size of what the finite difference differenced."""
         analytic, fd = np.asarray(analytic), np.asarray(fd)
         err = float(np.max(np.abs(analytic - fd))) if analytic.size else 0.0
-        mag = max(1.0, float(np.max(np.abs(fd), initial=0.0)),
+        mag = max(float(np.max(np.abs(fd), initial=0.0)),
                   float(np.max(np.abs(analytic), initial=0.0)))  # fmt: skip
-        report.rows.append(CheckRow(piece, i, err, report.rtol * mag, detail))
+        tol = report.rtol * mag + _NOISE * float(values)
+        report.rows.append(CheckRow(piece, i, err, tol, detail))
+
+    def size(a) -> float:
+        return float(np.max(np.abs(np.asarray(a)), initial=0.0))
 
     def with_q(qq):
         return np.concatenate([qq, v])
@@ -169,19 +212,23 @@ def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> N
         return np.concatenate([q, vv])
 
     if model.m:
-        add("f_q", ev("f_q", t, x, p), _jacobian(lambda qq: ev("f", t, with_q(qq), p), q))
-        add("f_t", ev("f_t", t, x, p), _scalar_derivative(lambda s: ev("f", s, x, p), t),
+        f0 = size(ev("f", t, x, p))
+        add("f_q", ev("f_q", t, x, p), _jacobian(lambda qq: ev("f", t, with_q(qq), p), q), f0)
+        add("f_t", ev("f_t", t, x, p), _scalar_derivative(lambda s: ev("f", s, x, p), t), f0,
             "" if "f_t" in model.functions else "model declares none")  # fmt: skip
 
         def fdot(s):  # ḟ along the motion q(s) = q + (s − t) v
             xx = np.concatenate([q + (s - t) * v, v])
             return ev("f_q", s, xx, p) @ v + ev("f_t", s, xx, p)
 
-        add("f_accel", ev("f_accel", t, x, p), _scalar_derivative(fdot, t))
+        # ḟ's terms, not ḟ itself (near zero on the manifold): their roundoff
+        terms = size(np.abs(ev("f_q", t, x, p)) @ np.abs(v)) + size(ev("f_t", t, x, p))
+        add("f_accel", ev("f_accel", t, x, p), _scalar_derivative(fdot, t), terms)
     if model.k:
-        add("h_q", ev("h_q", t, x, p), _jacobian(lambda qq: ev("h", t, with_q(qq), p), q))
-        add("h_v", ev("h_v", t, x, p), _jacobian(lambda vv: ev("h", t, with_v(vv), p), v))
-        add("h_t", ev("h_t", t, x, p), _scalar_derivative(lambda s: ev("h", s, x, p), t),
+        h0 = size(ev("h", t, x, p))
+        add("h_q", ev("h_q", t, x, p), _jacobian(lambda qq: ev("h", t, with_q(qq), p), q), h0)
+        add("h_v", ev("h_v", t, x, p), _jacobian(lambda vv: ev("h", t, with_v(vv), p), v), h0)
+        add("h_t", ev("h_t", t, x, p), _scalar_derivative(lambda s: ev("h", s, x, p), t), h0,
             "" if "h_t" in model.functions else "model declares none")  # fmt: skip
     for piece, pattern in (model.patterns or {}).items():
         value = ev(piece, t, x, p)

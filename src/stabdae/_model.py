@@ -371,9 +371,10 @@ class Model:
         return np.concatenate(parts)
 
     def check(self, params=None, *, states: int = 3, radius: float = 1e-2, seed: int = 0,
-              rtol: float = 1e-6):  # fmt: skip
+              rtol: float = 1e-6, velocity=None):  # fmt: skip
         """Compare the derivative pieces with finite differences; see :func:`stabdae.check`."""
-        return check_model(self, params, states=states, radius=radius, seed=seed, rtol=rtol)
+        return check_model(self, params, states=states, radius=radius, seed=seed, rtol=rtol,
+                           velocity=velocity)  # fmt: skip
 
     # ----------------------------------------------------------------- validation
     def _count(self, value, symbol: str) -> int:

@@ -123,3 +123,65 @@ def test_check_probes_every_state_with_bounds_checks():
     with pytest.raises(stabdae.ModelError, match=r"f_q\(t, q, p, out\) at check state \d+ "
                                                  r"writes outside out"):  # fmt: skip
         model.check(states=6, radius=0.5)
+
+
+C_SMALL = 1e-3  # the constraint in small units: f = c (x² + y² − 1)
+
+
+@njit
+def f_small(t, q, p, out):
+    out[0] = C_SMALL * (q[0] * q[0] + q[1] * q[1] - 1.0)
+
+
+@njit
+def f_q_small(t, q, p, out):
+    out[0, 0] = C_SMALL * 2.0 * q[0]
+    out[0, 1] = C_SMALL * 2.0 * q[1]
+
+
+@njit
+def f_accel_small(t, q, v, p, out):
+    out[0] = C_SMALL * 2.0 * (v[0] * v[0] + v[1] * v[1])
+
+
+@njit
+def f_accel_small_sign(t, q, v, p, out):
+    out[0] = C_SMALL * 2.0 * (v[0] * v[0] - v[1] * v[1])  # the sign of ẏ² wrong
+
+
+def _dp_sign_error():
+    """The shipped double pendulum (at rest in its reference state) with the sign of one
+    velocity-squared term of its f_accel wrong."""
+    dp = load_scene("double_pendulum")
+
+    @njit
+    def f_accel_sign(t, q, v, p, out):
+        du, dw = v[2] - v[0], v[3] - v[1]
+        out[0] = 2.0 * (v[0] * v[0] + v[1] * v[1])
+        out[1] = 2.0 * (du * du - dw * dw)  # should be + dw²
+
+    fns = {**dp.functions, "f_accel": f_accel_sign}
+    return stabdae.Model("dp_sign", dp.n, dp.m, dp.k, params=dp.params,
+                         reference_state=dp.reference_state, **fns)  # fmt: skip
+
+
+def test_check_catches_a_sign_error_in_a_velocity_squared_term_at_every_state():
+    """Velocities at the scale of the model's motion and errors relative to each piece's
+    own size: a sign error in a velocity-squared term of f_accel disagrees at every
+    sampled state, in a constraint of small units (f = 1e-3 (x² + y² − 1): with velocities
+    of 0.01 and a tolerance of at least 1e-6, its error of 4e-7 ẏ² passed at some states)
+    and in the shipped double pendulum (its reference state is at rest, where a
+    velocity-squared term is zero whatever its sign, so the reference state agrees).  The
+    correct pieces agree everywhere: no false alarm from the relative tolerance."""
+    small = pendulum(f=f_small, f_q=f_q_small, f_accel=f_accel_small_sign,
+                     reference_state=np.array([0.0, -1.0, 0.0, 0.0]))  # fmt: skip
+    for model in (small, _dp_sign_error()):
+        for seed in range(3):
+            report = model.check(states=4, seed=seed)
+            bad = {r.state for r in report.rows if r.piece == "f_accel" and not r.ok}
+            assert bad == {1, 2, 3, 4}, str(report)
+    good = pendulum(f=f_small, f_q=f_q_small, f_accel=f_accel_small,
+                    reference_state=np.array([0.0, -1.0, 0.0, 0.0]))  # fmt: skip
+    for seed in range(3):
+        assert good.check(states=4, seed=seed).ok
+    assert load_scene("double_pendulum").check(states=4).ok

@@ -39,7 +39,8 @@ def _cmd_check(args) -> int:
     from .._loading import load_model
 
     model = load_model(args.model)
-    report = model.check(_params(args.param), states=args.states, rtol=args.rtol)
+    report = model.check(_params(args.param), states=args.states, rtol=args.rtol,
+                         velocity=args.velocity)  # fmt: skip
     print(model)
     print(report)
     return 0 if report.ok else 1
@@ -222,6 +223,9 @@ def main(argv: list[str] | None = None) -> int:
     chk.add_argument("--param", action="append", metavar="NAME=VALUE",
                      help="a parameter value instead of the model's default (repeatable)")
     chk.add_argument("--states", type=int, default=3, help="random states besides the reference")
+    chk.add_argument("--velocity", type=float, default=None,
+                     help="scale of the random states' velocities, per second (default: the "
+                     "reference state's largest speed, or its largest coordinate at rest)")
     chk.add_argument("--rtol", type=float, default=1e-6,
                      help="relative tolerance of the finite-difference comparison")
     chk.set_defaults(func=_cmd_check)
