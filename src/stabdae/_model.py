@@ -370,6 +370,17 @@ class Model:
             parts.append(self.evaluate("h", t, x, p))
         return np.concatenate(parts)
 
+    def consistent_state(self, fixed=None, *, guess=None, params=None, t=None,
+                         tol: float = 1e-13) -> np.ndarray:  # fmt: skip
+        """A state on the constraint manifold with the components in ``fixed`` held (by
+        name or index) and the rest solved for by Newton's method: the positions from
+        ``f = 0``, then the velocities from ``ḟ = 0`` and ``h = 0``.  Refuses, naming them,
+        unknowns the constraints leave free and constraints the held values contradict.
+        See :func:`stabdae._consistent.consistent_state`."""
+        from ._consistent import consistent_state
+
+        return consistent_state(self, fixed, guess=guess, params=params, t=t, tol=tol)
+
     def check(self, params=None, *, states: int = 3, radius: float = 1e-2, seed: int = 0,
               rtol: float = 1e-6, velocity=None):  # fmt: skip
         """Compare the derivative pieces with finite differences; see :func:`stabdae.check`."""
