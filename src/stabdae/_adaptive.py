@@ -62,7 +62,8 @@ def integrate_adaptive(
         component of ``x = (q, v)`` where their scales differ (as SciPy's ``solve_ivp``
         takes it): a component near zero needs an ``atol`` below its own scale, and one
         number small enough for the smallest component makes every other one take steps
-        it does not need.
+        it does not need.  ``atol="scales"``: ``rtol`` times the model's declared
+        ``scales``.
     save_dt : float, optional
         Spacing of the stored samples (the last one at ``t_end``); steps end exactly on
         them.  Default: only ``t0`` and ``t_end``.
@@ -98,7 +99,7 @@ def integrate_adaptive(
     who = "integrate_adaptive"
     model = check.model(model, who)
     law = check.law(law, who, "stabdae.none() or stabdae.baumgarte(omega=10.0, xi=1.0)")
-    rtol, atol, atol_given = check.tolerances(rtol, atol, who, 2 * model.n)
+    rtol, atol, atol_given = check.tolerances(rtol, atol, who, 2 * model.n, model.scales)
     p = check.params(model, params, who)
     t0 = model.t0 if t0 is None else check.real(t0, "t0", who)
     check.span(t0, t_end, who)

@@ -20,8 +20,9 @@ differences' own roundoff, ``100 ε^{2/3}`` times the size of the values differe
 
 The states: the reference state, and ``states`` random ones whose coordinates lie within
 ``radius`` (relative) of the reference's and whose velocities are drawn at the scale of
-the motion: ``velocity`` per second (default: the reference's largest speed, or, at
-rest, its largest coordinate per second), around the reference's.  A velocity-squared
+the motion: ``velocity`` per second (default: the model's declared velocity ``scales``, else the
+reference's largest speed, or, at rest, its largest coordinate per second), around the
+reference's.  A velocity-squared
 term of ``f_accel`` is then of the size of the others, and a wrong sign in it shows at
 every random state (at a reference at rest it is zero whatever its sign).
 """
@@ -172,6 +173,8 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
     ts = [model.t0]
     n = model.n
     scale = np.maximum(1.0, np.abs(x_ref))
+    if velocity is None and model.scales is not None:
+        velocity = model.scales[n:]
     vscale = velocity_scale(x_ref, n, velocity)
     for _ in range(states):
         x = x_ref + radius * scale * rng.standard_normal(x_ref.shape)

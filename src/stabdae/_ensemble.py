@@ -206,8 +206,9 @@ def ensemble(
     rtol, atol : float, optional
         Adaptive steps: each member controls its own step with the scheme's embedded pair
         (Dormand–Prince 5(4) by default, or DOP853; as :func:`integrate_adaptive`) to
-        these tolerances (``atol`` defaults to ``rtol``; a number, or one per state
-        component, shape ``(2n,)``).  The dataset then also has
+        these tolerances (``atol`` defaults to ``rtol``; a number, one per state
+        component, shape ``(2n,)``, or ``"scales"``: ``rtol`` times the model's
+        ``scales``).  The dataset then also has
         ``steps_accepted`` and ``rhs_evaluations`` per member, and only the
         continuous-time prediction ``beta_theory``.
     members : int
@@ -512,7 +513,7 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
         pair = check.pair(None if scheme is None else check.scheme(scheme, who), who)
         scheme = pair.scheme
         rtol, atol, _ = check.tolerances(rtol, rtol if atol is None else atol, who,
-                                         2 * model.n)  # fmt: skip
+                                         2 * model.n, model.scales)  # fmt: skip
     elif atol is not None:
         raise ValueError(f"{who}: atol is for adaptive steps; give rtol as well")
     scheme = check.scheme(scheme, who, default="rk2")

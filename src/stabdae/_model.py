@@ -109,6 +109,11 @@ class Model:
         (``"dense"``).  A mapping declares patterns (boolean arrays of ``out``'s shape)
         for some pieces; the others are found.  ``model.patterns`` holds them,
         :meth:`check` verifies them.
+    scales : sequence of float, optional
+        The typical size of each state component, shape (2n,) (or (n,): each coordinate's,
+        its velocity's the same per second), in the coordinates' units: adaptive steps
+        with ``atol="scales"`` take ``atol = rtol · scales``, one per component, and
+        :meth:`check` draws its velocities at these sizes.
 
     Raises
     ------
@@ -152,6 +157,7 @@ class Model:
         t0: float = 0.0,
         description: str = "",
         sparsity: str | Mapping[str, np.ndarray] = "detect",
+        scales: Sequence[float] | None = None,
     ):
         self._args = {key: value for key, value in locals().items()
                       if key not in ("self", "__class__")}  # for :meth:`replace`
@@ -178,6 +184,7 @@ class Model:
         self.constraint_units = self._validate_units(constraint_units, self.m + self.k,
                                                      "constraint_units", "r = m + k")
         self.energy_units = str(energy_units)
+        self.scales = self._validate_scales(scales)
 
         given = dict(
             mass=mass, forces=forces, f=f, f_q=f_q, f_t=f_t, f_accel=f_accel,
@@ -388,6 +395,27 @@ class Model:
                            velocity=velocity)  # fmt: skip
 
     # ----------------------------------------------------------------- validation
+    def _validate_scales(self, scales) -> np.ndarray | None:
+        if scales is None:
+            return None
+        try:
+            arr = np.array(scales, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ModelError(f"Model {self.name!r}: scales must be numbers, one per state "
+                             f"component, shape (2n,) = ({2 * self.n},) or one per "
+                             f"coordinate, (n,) = ({self.n},); got {scales!r}") from None
+        if arr.shape == (self.n,):
+            arr = np.concatenate([arr, arr])
+        if arr.shape != (2 * self.n,):
+            raise ModelError(f"Model {self.name!r}: scales must have shape (2n,) = "
+                             f"({2 * self.n},) or (n,) = ({self.n},); got {arr.shape}")
+        bad = np.flatnonzero(~(np.isfinite(arr) & (arr > 0)))
+        if bad.size:
+            names = [self.state_names[i] for i in bad]
+            raise ModelError(f"Model {self.name!r}: scales must be positive and finite; "
+                             f"{', '.join(names)} are {arr[bad].tolist()}")
+        return arr
+
     def _count(self, value, symbol: str) -> int:
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
             raise ModelError(

@@ -110,14 +110,23 @@ def positive(value, name: str, who: str) -> float:
     return out
 
 
-def tolerances(rtol, atol, who: str, size: int):
+def tolerances(rtol, atol, who: str, size: int, scales=None):
     """The adaptive steps' ``(rtol, atol, as_given)``, one rule for every caller: ``rtol``
     positive and finite and at least 100 machine epsilons (below it the error estimate is
     roundoff, and the step size would shrink without end); ``atol`` a positive finite
     number or one per state component (shape ``(size,)`` = (2n,), as SciPy's
-    ``solve_ivp`` takes it), returned as an array of ``size`` either way, and as given
-    (a float, or the array) for the dataset."""
+    ``solve_ivp`` takes it), or ``"scales"``: ``rtol`` times the model's ``scales``;
+    returned as an array of ``size`` either way, and as given (a float, or the array)
+    for the dataset."""
     rtol = positive(rtol, "rtol", who)
+    if isinstance(atol, str):
+        if atol != "scales":
+            raise ValueError(f"{who}: atol must be a number, one per state component, or "
+                             f"'scales'; got {atol!r}")
+        if scales is None:
+            raise ValueError(f"{who}: atol='scales' takes rtol times the model's scales, and "
+                             "the model declares none (Model(..., scales=...))")
+        atol = rtol * np.asarray(scales, dtype=float)
     if np.ndim(atol) == 0:
         given = positive(atol, "atol", who)
         vector = np.full(size, given)

@@ -290,3 +290,36 @@ def test_atol_per_state_component():
                                          r"every component; components \[1, 3\] are "
                                          r"\[0.0, nan\]"):
         stabdae.ensemble(model, law, "dopri5", atol=[1e-9, 0.0, 1e-9, np.nan], **kw)
+
+
+def test_atol_from_the_models_scales():
+    """``Model(..., scales=...)`` declares each state component's size (or each
+    coordinate's, the velocities alike per second); ``atol="scales"`` is then ``rtol``
+    times them, bit for bit the explicit vector, in ``integrate_adaptive`` and the
+    adaptive ensemble.  Without declared scales, or with another string, it is refused;
+    scales of the wrong shape or not positive are refused by the model, by name."""
+    base = load_scene("pendulum")
+    model = base.replace(scales=[1.0, 1.0, 3.0, 3.0])
+    np.testing.assert_array_equal(base.replace(scales=[2.0, 0.5]).scales, [2.0, 0.5, 2.0, 0.5])
+    law = stabdae.baumgarte(10.0, 1.0)
+    vector = 1e-8 * np.array([1.0, 1.0, 3.0, 3.0])
+    by_scales = stabdae.integrate_adaptive(model, None, law, 1.0, rtol=1e-8, atol="scales")
+    explicit = stabdae.integrate_adaptive(model, None, law, 1.0, rtol=1e-8, atol=vector)
+    np.testing.assert_array_equal(by_scales.x.values, explicit.x.values)
+    np.testing.assert_array_equal(by_scales.attrs["atol"], vector)
+    kw = dict(tau=1e-3, t_end=0.5, members=6, seed=2, rtol=1e-8)
+    a = stabdae.ensemble(model, law, "dopri5", atol="scales", **kw)
+    b = stabdae.ensemble(model, law, "dopri5", atol=vector, **kw)
+    np.testing.assert_array_equal(a.x_final.values, b.x_final.values)
+    with pytest.raises(ValueError, match=r"^integrate_adaptive: atol='scales' takes rtol times "
+                                         r"the model's scales, and the model declares none"):
+        stabdae.integrate_adaptive(base, None, law, 1.0, atol="scales")
+    with pytest.raises(ValueError, match=r"^ensemble: atol must be a number, one per state "
+                                         r"component, or 'scales'; got 'scale'"):
+        stabdae.ensemble(model, law, "dopri5", atol="scale", **kw)
+    with pytest.raises(stabdae.ModelError, match=r"scales must have shape \(2n,\) = \(4,\) or "
+                                                 r"\(n,\) = \(2,\); got \(3,\)"):
+        base.replace(scales=[1.0, 1.0, 1.0])
+    with pytest.raises(stabdae.ModelError, match=r"scales must be positive and finite; y, "
+                                                 r"y_dot are \[0.0, 0.0\]"):
+        base.replace(scales=[1.0, 0.0])
