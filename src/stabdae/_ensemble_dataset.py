@@ -27,6 +27,7 @@ from ._schema import (
     SINGLE_PRECISION,
     cf_dataset,
     model_coords,
+    output_entries,
     provenance,
     schema_entry,
     variable,
@@ -146,6 +147,11 @@ def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, trace
         if name in values:
             values[name] = np.asarray(values[name], dtype=np.int32)
     data = {name: schema_entry(name, val, model) for name, val in values.items()}
+    if model.outputs is not None:  # at each member's final state; NaN for those that stopped
+        finals = model.derived(x_final, times[-1], p)
+        finals[stopped] = np.nan
+        data.update(output_entries(model, finals, ("member",), "_final",
+                                   " at the member's final state"))  # fmt: skip
     attrs = data["residual_norm"][2]
     attrs["comment"] = f"stored as {norms.dtype}; " + attrs["comment"]
     data["stability_radius"][2]["comment"] = radius_why

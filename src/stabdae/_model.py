@@ -27,6 +27,7 @@ import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
+import numba
 import numpy as np
 from numba.core.dispatcher import Dispatcher
 
@@ -109,6 +110,16 @@ class Model:
         (``"dense"``).  A mapping declares patterns (boolean arrays of ``out``'s shape)
         for some pieces; the others are found.  ``model.patterns`` holds them,
         :meth:`check` verifies them.
+    outputs : numba dispatcher ``outputs(t, q, v, p, out)``, optional
+        Derived quantities of a state (a steer angle from redundant coordinates, a contact
+        force's direction): ``out`` of shape ``(len(output_names),)``.  Trajectories store
+        each at every sample, as a variable of its own name; ensembles store each at every
+        member's final state, ``<name>_final``.
+    output_names : sequence of str
+        Their names (identifiers, not those of a dataset's own variables); required with
+        ``outputs``.
+    output_units : str or sequence of str, optional
+        Their UDUNITS units (default ``"1"``).
     scales : sequence of float, optional
         The typical size of each state component, shape (2n,) (or (n,): each coordinate's,
         its velocity's the same per second), in the coordinates' units: adaptive steps
@@ -158,6 +169,9 @@ class Model:
         description: str = "",
         sparsity: str | Mapping[str, np.ndarray] = "detect",
         scales: Sequence[float] | None = None,
+        outputs: Dispatcher | None = None,
+        output_names: Sequence[str] | None = None,
+        output_units: Sequence[str] | str | None = None,
     ):
         self._args = {key: value for key, value in locals().items()
                       if key not in ("self", "__class__")}  # for :meth:`replace`
@@ -196,6 +210,10 @@ class Model:
             if fn is not None:
                 self.functions[piece] = self._require_njit(piece, fn)
         self.energy = self._require_njit("energy", energy) if energy is not None else None
+        self.outputs = self._require_njit("outputs", outputs) if outputs is not None else None
+        self.output_names, self.output_units = self._validate_outputs(
+            outputs, output_names, output_units)  # fmt: skip
+        self._derived_loop = None
 
         p = self.default_params()
         self._reference = reference_state
@@ -395,6 +413,31 @@ class Model:
                            velocity=velocity)  # fmt: skip
 
     # ----------------------------------------------------------------- validation
+    def _validate_outputs(self, outputs, names, units) -> tuple[tuple, tuple]:
+        if outputs is None:
+            if names is not None or units is not None:
+                raise ModelError(f"Model {self.name!r}: output_names and output_units go "
+                                 "with outputs=, which is not given")  # fmt: skip
+            return (), ()
+        from ._schema import reserved_names
+
+        if names is None or isinstance(names, str) or len(names) == 0:
+            raise ModelError(f"Model {self.name!r}: outputs needs output_names, a list of "
+                             f"one name per output; got {names!r}")  # fmt: skip
+        names = tuple(str(nm) for nm in names)
+        taken = reserved_names()
+        for nm in names:
+            if not nm.isidentifier():
+                raise ModelError(f"Model {self.name!r}: output name {nm!r} is not an "
+                                 "identifier (letters, digits and _)")  # fmt: skip
+            if nm in taken or f"{nm}_final" in taken or nm in self.coordinates:
+                raise ModelError(f"Model {self.name!r}: output name {nm!r} is a dataset's "
+                                 "own variable or coordinate; choose another")  # fmt: skip
+        if len(set(names)) != len(names):
+            raise ModelError(f"Model {self.name!r}: output_names repeat a name: {names}")
+        units = self._validate_units(units, len(names), "output_units", "len(output_names)")
+        return names, tuple(units)
+
     def _validate_scales(self, scales) -> np.ndarray | None:
         if scales is None:
             return None
@@ -506,7 +549,31 @@ class Model:
             self._check_symmetric(outputs["mass"])
         if self.energy is not None:
             self._probe_energy(t, q, v, p)
+        if self.outputs is not None:
+            probe_output(f"Model {self.name!r}: outputs(t, q, v, p, out)", self.outputs,
+                         (float(t), np.ascontiguousarray(q), np.ascontiguousarray(v), p),
+                         (len(self.output_names),), "one per output_names")  # fmt: skip
         return outputs
+
+    def derived(self, x, t=None, params=None) -> np.ndarray:
+        """The model's derived ``outputs`` at the states ``x`` (shape (2n,) or (N, 2n)) and
+        times ``t`` (a number or one per state; default ``t0``): shape (len(output_names),)
+        or (N, len(output_names)); NaN for a state that is not finite."""
+        if self.outputs is None:
+            raise ModelError(f"Model {self.name!r} declares no outputs (Model(..., "
+                             "outputs=..., output_names=[...]))")  # fmt: skip
+        X = np.atleast_2d(np.asarray(x, dtype=np.float64))
+        if X.ndim != 2 or X.shape[1] != 2 * self.n:
+            raise ValueError(f"{self.name}.derived: x must have shape (2n,) or (N, 2n) with "
+                             f"2n = {2 * self.n}; got {np.shape(x)}")  # fmt: skip
+        T = np.broadcast_to(np.asarray(self.t0 if t is None else t, dtype=np.float64),
+                            (X.shape[0],)).copy()  # fmt: skip
+        p = self.param_vector(params) if not isinstance(params, np.ndarray) else params
+        out = np.full((X.shape[0], len(self.output_names)), np.nan)
+        if self._derived_loop is None:
+            self._derived_loop = _derived_loop_for(self.outputs)
+        self._derived_loop(T, np.ascontiguousarray(X), self.n, p, out)
+        return out[0] if np.ndim(x) == 1 else out
 
     # ----------------------------------------------------------------- sparsity
     def _sparsity(self, sparsity, x_ref, p, outputs) -> dict | None:
@@ -759,6 +826,19 @@ def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs:
             f"arrays (out of shape {shape}): {_first_lines(exc)}"
         ) from exc
     return compiled
+
+
+def _derived_loop_for(fn: Dispatcher):
+    """A compiled loop of ``fn(t_i, q_i, v_i, p, out_i)`` over the rows of a state array
+    (rows with a non-finite entry left as they are: NaN)."""
+
+    @numba.njit
+    def loop(T, X, n, p, out):
+        for i in range(X.shape[0]):
+            if np.all(np.isfinite(X[i])):
+                fn(T[i], X[i, :n].copy(), X[i, n:].copy(), p, out[i])
+
+    return loop
 
 
 def _call_compiled(fn: Dispatcher, *args):

@@ -394,6 +394,28 @@ def variable(dims, data, long_name: str, units: str | None, **attrs) -> xr.Varia
     return xr.Variable(dims, data, attrs={**head, **attrs})
 
 
+#: coordinate names of stabdae's datasets (beside the variables of :data:`SCHEMA`)
+_COORDINATES = ("time", "member", "trace", "state", "state_units", "component",
+                "component_units", "coordinate", "constraint", "acceleration_units",
+                "multiplier_units", "probe", "point")  # fmt: skip
+
+
+def reserved_names() -> set[str]:
+    """Names a model's derived outputs may not take: the datasets' own variables and
+    coordinates."""
+    return set(SCHEMA) | set(_COORDINATES)
+
+
+def output_entries(model, values, dims, suffix: str = "", comment: str = "") -> dict:
+    """The model's derived outputs as variables ``(dims, values[..., j], attrs)``, one per
+    name (``<name><suffix>``), with its own units."""
+    out = {}
+    for j, (name, unit) in enumerate(zip(model.output_names, model.output_units)):
+        attrs = {"long_name": f"{name}: a derived output of the model{comment}", "units": unit}
+        out[f"{name}{suffix}"] = (dims, values[..., j], attrs)
+    return out
+
+
 def schema_variable(name: str, data, model=None, dims=None, key: str | None = None
                     ) -> xr.Variable:  # fmt: skip
     """Variable ``name`` of :data:`SCHEMA` (entry ``key``, default ``name``) holding
@@ -543,6 +565,8 @@ def trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, r
     data["residual_norm"].attrs["comment"] = "NaN after a stop"
     if model.energy is not None:
         data["energy"] = schema_variable("energy", es, model)
+    if model.outputs is not None:
+        data.update(output_entries(model, model.derived(xs, times, p), ("time",)))
     coords = model_coords(model, times)
     if multipliers is not None:
         data["multiplier"] = schema_variable("multiplier", multipliers[0], model)

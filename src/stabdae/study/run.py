@@ -120,7 +120,8 @@ def _fingerprint(study: Study) -> str:
     # the model's functions as the kernels are keyed: helpers they call wherever those
     # live, and the values of the globals and module attributes they read
     model = study.model
-    for piece, fn in sorted({**model.functions, "energy": model.energy}.items()):
+    for piece, fn in sorted({**model.functions, "energy": model.energy,
+                             "outputs": model.outputs}.items()):  # fmt: skip
         h.update(f"{piece}={function_fingerprint(fn) if fn is not None else None}".encode())
     return h.hexdigest()
 
