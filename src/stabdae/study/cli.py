@@ -197,8 +197,11 @@ def _cmd_generate(args) -> int:
         print(system.source(args.spec), end="")
         return 0
     out = system.write(args.output, spec=args.spec)
+    ops = system.operations
+    largest = max(ops, key=ops.get)
     print(f"model {system.name!r} (n = {system.n}, m = {system.m}, k = {system.k}) written to "
-          f"{out} in {time.perf_counter() - start:.1f} s")  # fmt: skip
+          f"{out} in {time.perf_counter() - start:.1f} s: {sum(ops.values())} operations "
+          f"after common subexpressions (the most in {largest}: {ops[largest]})")  # fmt: skip
     if args.no_check:
         return 0
     from .._loading import load_model
