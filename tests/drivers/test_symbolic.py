@@ -18,7 +18,7 @@ import sympy as sp
 from test_residual_law import constant_laws, relative_law_error
 
 import stabdae
-from conftest import KERNELS, load_scene
+from conftest import KERNELS, ROOT, load_file, load_scene
 from stabdae.study.cli import main
 from stabdae.symbolic import SymbolicError, System, coordinates, generate, load_spec
 
@@ -261,35 +261,17 @@ def test_load_model_names_the_model_files_own_error_and_line(tmp_path):
     assert str(info.value).startswith(f"load_model: {path}:3: NameError: name 'undefined_mass'")
 
 
-def _chain_to_a_pin(links: int, **options) -> System:
-    """A chain of ``links`` rods in its joint angles (minimal coordinates) whose tip is
-    held at a fixed distance from a pin: a constraint that nests the angles in a square
-    root of squared sums, as contact and closure constraints of mechanisms do."""
-    th, thd = coordinates(" ".join(f"th{i}" for i in range(links)))
-    g, l, m = sp.symbols("g l m")
-    x = y = xd = yd = kinetic = potential = 0
-    for i in range(links):
-        x, y = x + l * sp.sin(th[i]), y - l * sp.cos(th[i])
-        xd, yd = xd + l * sp.cos(th[i]) * thd[i], yd + l * sp.sin(th[i]) * thd[i]
-        kinetic += m * (xd**2 + yd**2) / 2
-        potential += m * g * y
-    angles = [0.3 * (-1) ** i for i in range(links)]
-    tip = (sum(math.sin(a) for a in angles), -sum(math.cos(a) for a in angles))
-    r = math.hypot(tip[0] - 0.5, tip[1] + 0.2)
-    return System(f"chain{links}", q=list(th), v=list(thd), lagrangian=kinetic - potential,
-                  holonomic=[sp.sqrt((x - 0.5 * l) ** 2 + (y + 0.2 * l) ** 2) - r * l],
-                  params={g: 9.81, l: 1.0, m: 1.0}, reference_state=angles + [0.0] * links,
-                  **options)  # fmt: skip
-
-
 def test_unexpanded_derivation_is_the_same_model_in_fewer_operations(tmp_path):
     """``expand=False`` keeps the product and chain rules' trees and lets common
     subexpressions share them: the same model (every piece within 1e-12 at random
     states, and it passes check) in well under half the operations of the expanded one
     (measured: 478 against 1361 at 3 links; at 5 links 1006 against 7222, derived in
     0.7 s against 129 s).  ``stabdae generate`` reports the count."""
-    expanded = _chain_to_a_pin(3, simplify=False)
-    kept = _chain_to_a_pin(3, simplify=False, expand=False)
+    # a chain of rods in its joint angles whose tip is held at a fixed distance from a
+    # pin: a constraint that nests the angles in a square root of squared sums
+    chain = load_file(ROOT / "studies" / "bench_generate.py", "stabdae_bench_generate").minimal
+    expanded = chain(3, simplify=False)
+    kept = chain(3, simplify=False, expand=False)
     a = stabdae.load_model(expanded.write(tmp_path / "expanded.py"))
     b = stabdae.load_model(kept.write(tmp_path / "kept.py"))
     worst, compared = largest_difference(b, a)
