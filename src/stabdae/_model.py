@@ -568,7 +568,7 @@ class Model:
                              f"2n = {2 * self.n}; got {np.shape(x)}")  # fmt: skip
         T = np.broadcast_to(np.asarray(self.t0 if t is None else t, dtype=np.float64),
                             (X.shape[0],)).copy()  # fmt: skip
-        p = self.param_vector(params) if not isinstance(params, np.ndarray) else params
+        p = self.param_vector(params)
         out = np.full((X.shape[0], len(self.output_names)), np.nan)
         if self._derived_loop is None:
             self._derived_loop = _derived_loop_for(self.outputs)
