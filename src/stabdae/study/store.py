@@ -17,6 +17,7 @@ bytes differ from the recorded checksum, or that cannot be read, is computed aga
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import os
@@ -77,9 +78,6 @@ class Manifest:
         tmp = self.parts / f".{self.NAME}.tmp"
         tmp.write_text(text)
         os.replace(tmp, self.parts / self.NAME)  # a kill leaves the old or the new one
-
-    def points_done(self) -> int:
-        return sum(len(c["points"]) for c in self.chunks.values())
 
 
 #: what a run writes in ``OUTPUT.parts`` (and :func:`clear` removes; ``point-*.nc``: the
@@ -181,8 +179,6 @@ def _chunk_number(name: str) -> int:
 
 
 def _sha256(data: bytes) -> str:
-    import hashlib
-
     return hashlib.sha256(data).hexdigest()
 
 
