@@ -31,6 +31,7 @@ from ._schemes import (
     rk4,
     two_stage,
 )
+from ._sequential import Sequential
 from ._version import __version__
 
 __all__ = [
@@ -41,6 +42,7 @@ __all__ = [
     "ModelError",
     "Scheme",
     "SchemeError",
+    "Sequential",
     "Status",
     "__version__",
     "acpr",

@@ -11,10 +11,11 @@ code takes a new value.
 Families: :class:`Status` (a right-hand side's evaluation or a member's integration),
 :class:`BetaReason` (why a member has a decay rate or not), :class:`FitKind` (which fit
 gave it), :class:`StabilityClass` (a member's class), :class:`Verdict` and
-:class:`VerdictReason` (a member's verdict and why), :class:`RadiusReason` (how δ* is
-known), :class:`TauStarReason` (how a
-boundary search ended), :class:`ProbeStage` (a boundary search's probes) and
-:class:`LawKind` (how the right-hand side evaluates the law: compile-time, never stored).
+:class:`VerdictReason` (a member's verdict and why), :class:`DecisionReason` (a
+sequentially run cell's decision), :class:`RadiusReason` (how δ* is known),
+:class:`TauStarReason` (how a boundary search ended), :class:`ProbeStage` (a boundary
+search's probes) and :class:`LawKind` (how the right-hand side evaluates the law:
+compile-time, never stored).
 
 To add a code: a member with the next free value and its message in its family.  The
 flag attributes and the schema page follow; a kernel that returns it compares with
@@ -26,8 +27,9 @@ from __future__ import annotations
 import re
 from enum import IntEnum
 
-__all__ = ["BetaReason", "FitKind", "LawKind", "ProbeStage", "Status", "StabilityClass",
-           "TauStarReason", "RadiusReason", "Verdict", "VerdictReason", "flag_attrs"]  # fmt: skip
+__all__ = ["BetaReason", "DecisionReason", "FitKind", "LawKind", "ProbeStage", "Status",
+           "StabilityClass", "TauStarReason", "RadiusReason", "Verdict", "VerdictReason",
+           "flag_attrs"]  # fmt: skip
 
 
 class _Codes(IntEnum):
@@ -72,6 +74,9 @@ class Status(_Codes):
                          "singular or non-finite right-hand side)")
     #: adaptive integration: the step budget (max_steps) was used up
     MAX_STEPS = 7, "adaptive integration used up max_steps"
+    #: a study's grid point run until decided stopped before this member (its row is
+    #: padding, up to the most members any grid point ran)
+    NOT_NEEDED = 8, "not run: its grid point was decided with fewer members"
 
     @property
     def description(self) -> str:
@@ -96,6 +101,7 @@ _STATUS_SHORT = {
     Status.SAMPLING_FAILED: "not placed (sampling failed)",
     Status.STEP_TOO_SMALL: "step too small",
     Status.MAX_STEPS: "max_steps used up",
+    Status.NOT_NEEDED: "not needed",
 }
 
 
@@ -182,6 +188,21 @@ class VerdictReason(_Codes):
                             "law's bound and rose over the last three fifths, but stayed "
                             "below where it started: the floor of a motion that has left "
                             "the reference's, which this run cannot tell from slow growth")
+
+
+class DecisionReason(_Codes):
+    """Why a cell run member by member until decided (``decision_reason``) has its
+    decision: the interval ``[fraction_unstable_low, fraction_unstable_high]`` at the
+    cell's confidence against ``q``."""
+
+    STABLE = 0, "stable: the interval's upper end is at most q"
+    UNSTABLE = 1, "unstable: the interval's lower end is above q"
+    MAX_REACHED = 2, "max members reached: the interval still contains q"
+    MEMBERS_UNDECIDED = 3, ("members undecided: more than q of the members are not judged "
+                            "stable, and no more than q unstable (their verdict_reason says "
+                            "why)")
+    WITHIN_TOLERANCE = 4, ("within tolerance: the interval is narrower than the tolerance "
+                           "and contains q")
 
 
 class TauStarReason(_Codes):

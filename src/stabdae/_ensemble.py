@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 
@@ -21,11 +22,13 @@ import xarray as xr
 
 from . import _measures, theory
 from . import _validate as check
-from ._codes import Status
+from ._codes import DecisionReason, Status
 from ._ensemble_dataset import Table, _warn_stopped
 from ._ensemble_dataset import ensemble_table as _table
 from ._model import Model
 from ._raised import first_raising_member, model_raised, stage_finder
+from ._schema import schema_entry
+from ._sequential import Sequential, decide
 from .engine.crash import guard
 from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
@@ -80,6 +83,9 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
     radius : float or (low, high)
         ``‖α⁰‖∞`` is log-uniform in ``[low, high]``; directions are uniform.
     seed : int or numpy.random.Generator
+        Member ``i``'s target is a function of the seed and ``i`` alone (a counter-based
+        generator): the first ``k`` members of a larger sample are those of a sample of
+        ``k``.  A generator gives the key (two draws from it).
     params : mapping or array, optional
     t0 : float, optional
         Time of the initial states (default the model's ``t0``).
@@ -105,8 +111,7 @@ def sample_perturbations(model: Model, members: int, radius=(1e-6, 1e-2), seed=0
     p = check.params(model, params, who)
     t0 = model.t0 if t0 is None else check.real(t0, "t0", who)
     threads = _threads(threads, who)
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    targets = draw_alphas(model.n_residual, members, (low, high), rng)
+    targets = draw_alphas(model.n_residual, members, (low, high), seed)
     return _place(model, targets, p, t0, threads)
 
 
@@ -211,15 +216,21 @@ def ensemble(
         ``scales``).  The dataset then also has
         ``steps_accepted`` and ``rhs_evaluations`` per member, and only the
         continuous-time prediction ``beta_theory``.
-    members : int
-        Ensemble size (ignored when ``x0`` is given).  An ensemble whose estimated memory
+    members : int, Sequential or dict
+        Ensemble size (ignored when ``x0`` is given).  A :class:`stabdae.Sequential` plan
+        (or a dict of its keys) runs members in batches until the ensemble is decided:
+        stable (at most ``q`` of the members unstable) or unstable at the plan's
+        confidence, or undecided (said why); the dataset then has the members run, and
+        ``decision``, ``decision_reason``, ``decision_low``, ``decision_high``,
+        ``members_used``; its traced members are the first ones.  An ensemble whose estimated memory
         (about ``8 (8n + 4(2m + k) + 48)`` bytes per member, plus the traces) exceeds the
         memory available is refused with the figures before anything is allocated.
     radius : float or (low, high)
         Range of ``‖α⁰‖∞``, log-uniform; directions uniform.
     seed : int
-        Seed (a non-negative integer, stored in the dataset) of the
-        ``numpy.random.Generator`` that draws the perturbations.
+        Seed (a non-negative integer, stored in the dataset) of the perturbations: member
+        ``i``'s is a function of the seed and ``i`` alone (a counter-based generator), so
+        the first ``k`` members of any ensemble with this seed are the same.
     x0 : array (members, 2n), optional
         The user's own initial states instead of sampled ones.
     params : mapping or array, optional
@@ -295,9 +306,23 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
                    states=True) -> Table:  # fmt: skip
     """:func:`ensemble`'s dataset as a :class:`~._ensemble_dataset.Table` (what a study
     keeps per grid point), without the warning for stopped members."""
+    plan = None
+    if isinstance(members, (Sequential, Mapping)):
+        plan = Sequential.of(members, "ensemble")
+        if x0 is not None:
+            raise ValueError("ensemble: members as a sequential plan runs sampled members; "
+                             "with x0 give no members")  # fmt: skip
+        members = plan.max
     run = _run_spec("ensemble", model, law, scheme, tau, t_end, rtol, atol, members, radius,
                     seed, save_dt, x0, params, epsilon, divergence, block, threads, progress,
-                    residual_dtype, traces, states)  # fmt: skip
+                    residual_dtype, traces, states, first=plan is not None)  # fmt: skip
+    # the law's transient and the accumulation of per-step errors over this run (R over the
+    # run's steps, or the prediction's), from one walk over R's powers
+    peak, gain = (theory.power_norms(run.R, run.mode.prediction_steps)
+                  if run.R.shape[0] > 0 else (math.nan, math.inf))  # fmt: skip
+    times = run.mode.times(run.t0)
+    if plan is not None:
+        return _sequential_table(run, plan, peak, gain, times)
     clock = time.perf_counter()
     placed = None
     try:
@@ -310,12 +335,18 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
     wall_integrate = time.perf_counter() - clock
     status = np.where(status != 0, status, out.status).astype(np.int8)
     clock = time.perf_counter()
-    # the law's transient and the accumulation of per-step errors over this run (R over the
-    # run's steps, or the prediction's), from one walk over R's powers
-    peak, gain = (theory.power_norms(run.R, run.mode.prediction_steps)
-                  if run.R.shape[0] > 0 else (math.nan, math.inf))  # fmt: skip
     referee = _referee(run, g_ref)
-    times = run.mode.times(run.t0)
+    roundoff = _roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
+                         run.threads, run.sampled)  # fmt: skip
+    table = _build(run, times, x0, alpha0, out, status, referee, peak, roundoff)
+    # wall times (compilation included on a first call) for benchmarks; not part of the data
+    table.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
+                       wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
+    return table
+
+
+def _build(run, times, x0, alpha0, out, status, referee, peak, roundoff) -> Table:
+    """The ensemble's table from its members' outputs."""
     table = _table(
         run.model, run.p, run.law, run.scheme, run.bound, times, x0, alpha0, out.norms,
         run.traced, out.x_final, status, out.fail_step, out.e0, out.e1, run.epsilon,
@@ -325,16 +356,96 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
              sampling_rtol=SAMPLING_RTOL,
              threads=run.threads if run.threads is not None else default_threads()),
         extra=run.mode.extra(out), overshoot_theory=peak, adaptive=run.adaptive,
-        roundoff=_roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
-                           run.threads, run.sampled),
-        referee=referee,
+        roundoff=roundoff, referee=referee,
     )  # fmt: skip
     if not run.states:
         del table.data["x0"], table.data["x_final"]
-    # wall times (compilation included on a first call) for benchmarks; not part of the data
+    return table
+
+
+def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Table:
+    """The ensemble run look by look until its decision (:mod:`._sequential`): the
+    members ``0 … n − 1`` of the last look, each as the one-shot ensemble of ``n``
+    members would give it, with the decision, its reason and interval."""
+    looks = plan.looks()
+    parts, g_ref, referee, roundoff = [], None, None, 0.0
+    wall_sample = wall_integrate = 0.0
+    lo = 0
+    progress = run.progress
+    for j, hi in enumerate(looks):
+        sub = replace(run, members=hi - lo, start=lo, trace_row=run.trace_row[lo:hi],
+                      progress=None if progress is None
+                      else (lambda done, _, lo=lo: progress(lo + done, plan.max)))  # fmt: skip
+        clock = time.perf_counter()
+        placed = None
+        try:
+            x0, alpha0, status, g = placed = _members(sub, None, reference=g_ref is None)
+            wall_sample += time.perf_counter() - clock
+            clock = time.perf_counter()
+            if g_ref is None:
+                g_ref, referee = g, _referee(run, g)
+            out = run.mode.integrate(sub, x0, alpha0, status, g_ref)
+        except Exception as exc:
+            raise _raised_in(sub, "ensemble", exc, None if placed is None else x0) from exc
+        wall_integrate += time.perf_counter() - clock
+        status = np.where(status != 0, status, out.status).astype(np.int8)
+        parts.append((x0, alpha0, out, status))
+        if lo == 0:  # the roundoff level from the first members: the same at any batch
+            k = min(ROUNDOFF_SAMPLE, hi)
+            roundoff = _roundoff(run.model, out.x_final[:k], status[:k], run.p,
+                                 float(times[-1]), gain, run.threads, run.sampled)  # fmt: skip
+        x0, alpha0, out, status = _joined(parts, run.trace_row[:hi])
+        verdicts, _ = _measures.verdict(Record(out.meas.copy(), out.codes.copy()), status,
+                                        roundoff=roundoff, **referee)  # fmt: skip
+        unstable = int((verdicts == _measures.V_UNSTABLE).sum())
+        stable = int((verdicts == _measures.V_STABLE).sum())
+        decision = decide(plan, hi, unstable, hi - stable, last=j == len(looks) - 1)
+        if decision.verdict is not None:
+            break
+        lo = hi
+    clock = time.perf_counter()
+    traced = run.traced[run.traced < hi]
+    out = out._replace(norms=out.norms[:traced.size])
+    table = _build(replace(run, members=hi, traced=traced, trace_row=run.trace_row[:hi]),
+                   times, x0, alpha0, out, status, referee, peak, roundoff)  # fmt: skip
+    for name, value in (("decision", np.int8(decision.verdict)),
+                        ("decision_reason", np.int8(decision.reason)),
+                        ("decision_low", decision.low), ("decision_high", decision.high),
+                        ("members_used", np.int32(hi))):  # fmt: skip
+        table.data[name] = schema_entry(name, value, run.model)
+    table.attrs.update({f"sequential_{k}": v for k, v in plan.as_dict().items()})
+    table.attrs["sequential_looks"] = np.asarray(looks[:j + 1], dtype=np.int64)
+    table.attrs["decision_summary"] = (
+        f"{_measures.VERDICTS[decision.verdict]} after {hi} members ({unstable} unstable, "
+        f"{hi - stable - unstable} undecided): the unstable fraction in "
+        f"[{decision.low:.3g}, {decision.high:.3g}] at confidence {plan.confidence:g}, "
+        f"q = {plan.q:g}; {DECISION_REASONS[decision.reason]}")  # fmt: skip
     table.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
                        wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
     return table
+
+
+def _joined(parts, trace_row):
+    """One set of members' ``(x0, alpha0, outputs, status)`` from the looks' parts, in
+    order; the traced members' rows from the part that ran them."""
+    if len(parts) == 1:
+        return parts[0]
+    x0 = np.concatenate([p[0] for p in parts])
+    alpha0 = np.concatenate([p[1] for p in parts])
+    status = np.concatenate([p[3] for p in parts])
+    outs = [p[2] for p in parts]
+    norms = np.empty_like(outs[0].norms)
+    lo = 0
+    for o in outs:
+        hi = lo + o.status.shape[0]
+        rows = trace_row[lo:hi]
+        rows = rows[rows >= 0]
+        norms[rows] = o.norms[rows]
+        lo = hi
+    cat = {f: np.concatenate([getattr(o, f) for o in outs])
+           for f in ("meas", "codes", "x_final", "status", "fail_step", "e0", "e1", "steps",
+                     "nfev")}  # fmt: skip
+    return x0, alpha0, outs[0]._replace(norms=norms, **cat), status
 
 
 # --------------------------------------------------------------------- the run spec
@@ -494,6 +605,7 @@ class _RunSpec:
     sampled: bool
     R: np.ndarray  # the linear prediction's one-step propagator (empty: none)
     h_pred: float  # ... and its step
+    start: int = 0  # the index of the first member (of a sequential ensemble's look)
 
     @property
     def adaptive(self) -> bool:
@@ -502,9 +614,11 @@ class _RunSpec:
 
 def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, seed,
               save_dt, x0, params, epsilon, divergence, block, threads, progress,
-              residual_dtype, traces, states) -> _RunSpec:  # fmt: skip
+              residual_dtype, traces, states, first=False) -> _RunSpec:  # fmt: skip
     """Every argument of :func:`ensemble` checked, in the order of its signature, and
-    the run spec they make (the kernel compiled or loaded once, here)."""
+    the run spec they make (the kernel compiled or loaded once, here); ``first``: the
+    traced members are the first ones (a sequential ensemble's, whose size is not known
+    yet), not spread over ``members``."""
     model = check.model(model, who)
     law = check.law(law, who)
     adaptive = rtol is not None
@@ -553,7 +667,7 @@ def _run_spec(who, model, law, scheme, tau, t_end, rtol, atol, members, radius, 
                              np.dtype(rdtype).itemsize),
         f"members = {members} with {traced_count} traces of {samples} samples", who,
         "run fewer members (several ensembles with other seeds), or store fewer traces")
-    trace_row, traced = _trace_rows(traces, members, who)
+    trace_row, traced = _trace_rows(traces, members, who, first)
     if not isinstance(states, (bool, np.bool_)):
         raise TypeError(f"{who}: states must be True or False, got {states!r}")
     bound = check.bound_law(law, model, who)
@@ -618,19 +732,22 @@ def default_divergence(epsilon, high, R, steps) -> float:
     return level
 
 
-def _members(run: _RunSpec, x0):
+def _members(run: _RunSpec, x0, reference: bool = True):
     """``(x0, alpha0, status, g_ref)``: the members, sampled at the seed's targets or the
     user's own, with the reference trajectory's residuals (:meth:`_Fixed.reference`; no
-    rows: none).  The reference runs beside the placing only while the kernel is still to
-    be compiled or loaded (its run alone is too short to pay for a thread)."""
+    rows: none; without ``reference``: None).  The reference runs beside the placing only
+    while the kernel is still to be compiled or loaded (its run alone is too short to pay
+    for a thread)."""
     model, p, t0 = run.model, run.p, run.t0
     none = np.zeros((0, model.n_residual))
     if x0 is not None:
         alpha0 = _residual_rows(model, x0, p, t0, run.threads)
         status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
         return x0, alpha0, status.astype(np.int8), none
-    targets = draw_alphas(model.n_residual, run.members, (run.low, run.high),
-                          np.random.default_rng(run.seed))  # fmt: skip
+    targets = draw_alphas(model.n_residual, run.members, (run.low, run.high), run.seed,
+                          run.start)  # fmt: skip
+    if not reference:
+        return (*_place(model, targets, p, t0, run.threads), None)
     if run.adaptive or run.mode.kernel.signatures:
         x0, alpha0, status = _place(model, targets, p, t0, run.threads)
         g_ref = run.mode.reference(run)
@@ -711,9 +828,9 @@ def _reference_floor(run: _RunSpec) -> np.ndarray:
     return band
 
 
-def _trace_rows(traces, members: int, who: str):
+def _trace_rows(traces, members: int, who: str, first: bool = False):
     """``(trace_row, traced)``: each member's row of the stored traces (−1: none) and the
-    traced members, evenly spaced over the ensemble."""
+    traced members, evenly spaced over the ensemble (``first``: the first ones)."""
     if isinstance(traces, str):
         if traces not in ("all", "none"):
             raise ValueError(f"{who}: traces must be a number of members, 'all' or 'none', "
@@ -726,8 +843,11 @@ def _trace_rows(traces, members: int, who: str):
         raise ValueError(f"{who}: traces must be >= 0, got {traces}")
     else:
         count = min(int(traces), members)
-    traced = np.unique(np.linspace(0, members - 1, count).round().astype(np.int64)) if count \
-        else np.zeros(0, dtype=np.int64)  # fmt: skip
+    if first:
+        traced = np.arange(count, dtype=np.int64)
+    else:
+        traced = np.unique(np.linspace(0, members - 1, count).round().astype(np.int64)) \
+            if count else np.zeros(0, dtype=np.int64)  # fmt: skip
     trace_row = np.full(members, -1, dtype=np.int64)
     trace_row[traced] = np.arange(traced.size)
     return trace_row, traced
@@ -772,6 +892,7 @@ def measure_stride(R) -> int:
 
 #: members whose final states set the roundoff level the growth test compares with
 ROUNDOFF_SAMPLE = 16
+DECISION_REASONS = {int(c): c.message for c in DecisionReason}
 
 
 def _roundoff(model, x_final, status, p, t, gain, threads, sampled=False):

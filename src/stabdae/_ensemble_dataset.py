@@ -19,7 +19,7 @@ import numpy as np
 import xarray as xr
 
 from . import _measures, theory
-from ._codes import Status
+from ._codes import BetaReason, StabilityClass, Status, Verdict, VerdictReason
 from ._integrate import IntegrationWarning
 from ._laws import Theorem5
 from ._schema import (
@@ -33,6 +33,14 @@ from ._schema import (
     variable,
 )
 from .engine import decay
+
+#: what a grid point's row holds for a member it did not run (a study pads the tables of
+#: grid points run until decided to the most members any ran): NaN for real numbers,
+#: these for integers, 0 for the other integers
+NOT_RUN = {"status": int(Status.NOT_NEEDED), "verdict": int(Verdict.UNDECIDED),
+           "verdict_reason": int(VerdictReason.NOT_RUN),
+           "stability_class": int(StabilityClass.NOT_RUN),
+           "beta_reason": int(BetaReason.STOPPED), "diverged_step": -1}  # fmt: skip
 
 
 @dataclass

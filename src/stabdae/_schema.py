@@ -32,6 +32,7 @@ import xarray as xr
 
 from ._codes import (
     BetaReason,
+    DecisionReason,
     FitKind,
     ProbeStage,
     RadiusReason,
@@ -126,6 +127,15 @@ SCHEMA: dict[str, tuple] = {
     "steps_accepted": ("member", "accepted steps (adaptive steps)", "1", {}),
     "rhs_evaluations": ("member", "right-hand-side evaluations (adaptive steps)", "1", {}),
     "energy_drift": ("member", "energy change E(final) - E(x0)", ENERGY, {}),
+    "decision": ((), "the cell's decision, run member by member: stable (at most q of its "
+                 "members unstable), unstable (more) or undecided", "1", flag_attrs(Verdict)),
+    "decision_reason": ((), "why the cell has its decision", "1", flag_attrs(DecisionReason)),
+    "decision_low": ((), "sequential interval of the unstable fraction, low (from the "
+                     "unstable members; holds at every look at the stated confidence)", "1",
+                     {}),
+    "decision_high": ((), "sequential interval of the unstable fraction, high (from the "
+                      "members not stable: unstable or undecided)", "1", {}),
+    "members_used": ((), "members run before the decision", "1", {}),
     "fraction_stable": ((), "fraction of stable members (of those that ran)", "1", {}),
     "fraction_stable_low": ((), "Wilson 95% interval of fraction_stable, low", "1", {}),
     "fraction_stable_high": ((), "Wilson 95% interval of fraction_stable, high", "1", {}),
@@ -327,6 +337,7 @@ def schema_markdown() -> str:
 #: the stored code variables and their families, as the schema page lists them
 _CODE_VARIABLES = (("status", Status), ("beta_reason", BetaReason), ("fit_kind", FitKind),
                    ("verdict", Verdict), ("verdict_reason", VerdictReason),
+                   ("decision", Verdict), ("decision_reason", DecisionReason),
                    ("stability_class", StabilityClass),
                    ("stability_radius_reason", RadiusReason),
                    ("tau_star_reason", TauStarReason), ("probe_stage", ProbeStage))  # fmt: skip

@@ -3,6 +3,9 @@
 * ``<stem>_stability.png`` — the stability map: ``fraction_stable`` over the first two
   swept axes, with the theory's boundaries drawn over it (``ρ(R(τÃ)) = 1`` and the
   weighted-norm condition of Theorems 6/7); with one swept axis, a curve.
+* ``<stem>_decision.png`` — for grid points run until decided (``[ensemble] members =
+  { ... }``): each cell coloured by its decision (stable, unstable, undecided with its
+  reason) beside the members it used, over the same theory outline.
 * ``<stem>_decay.png`` — residual decay of sampled members at one grid point, each with
   its fitted ``γ e^{−βt}`` and the theory's rate.
 * ``<stem>_beta.png`` — median fitted ``β`` against the predicted one at every grid point.
@@ -23,8 +26,8 @@ import xarray as xr
 
 from ._version import __version__
 
-__all__ = ["plot_dataset", "stability_map", "decay_curves", "beta_comparison",
-           "boundary_curve"]
+__all__ = ["plot_dataset", "stability_map", "decision_map", "decay_curves",
+           "beta_comparison", "boundary_curve"]
 
 
 def _plt():
@@ -158,6 +161,69 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
         ax.text(0.5, 0.5, f"nothing swept: {name} = {frac:.3g}", ha="center",
                 transform=ax.transAxes)  # fmt: skip
     ax.set_title(title, fontsize=10)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    return path
+
+
+def decision_map(ds: xr.Dataset, path: Path) -> Path:
+    """Each grid point's decision (stable, unstable, undecided) and the members it took,
+    over the first two swept axes (one axis: a strip), with the outline ``ρ(R(τÃ)) < 1``."""
+    from matplotlib.colors import ListedColormap, LogNorm
+
+    plt = _plt()
+    dims = _sweep_dims(ds)
+    sub, note = _first_of_others(ds, tuple(dims[:2]))
+    if len(dims) == 1:
+        sub = sub.expand_dims(_row=[0])
+        dims = [dims[0], "_row"]
+    xd, yd = dims[0], dims[1]
+    x, y = sub[xd].values, sub[yd].values
+    xlog, ylog = _is_log(x), _is_log(y)
+    xe, ye = _edges(x, xlog), _edges(y, ylog)
+    dec = sub["decision"].transpose(yd, xd).values
+    used = sub["members_used"].transpose(yd, xd).values
+    fig, axes = plt.subplots(1, 2, figsize=(11.5, 4.8), constrained_layout=True)
+    colors = ListedColormap(["#3b8b3b", "#c0392b", "#bdbdbd"])
+    axes[0].pcolormesh(xe, ye, dec, cmap=colors, vmin=-0.5, vmax=2.5, shading="flat")
+    mesh = axes[1].pcolormesh(xe, ye, used, cmap="magma_r", shading="flat",
+                              norm=LogNorm(vmin=max(1, used.min()), vmax=max(2, used.max())))
+    fig.colorbar(mesh, ax=axes[1], label="members used")
+    for j, row in enumerate(used):  # the counts, readable without the colour bar
+        for i, n in enumerate(row):
+            cx = np.sqrt(xe[i] * xe[i + 1]) if xlog else 0.5 * (xe[i] + xe[i + 1])
+            cy = np.sqrt(ye[j] * ye[j + 1]) if ylog else 0.5 * (ye[j] + ye[j + 1])
+            axes[1].text(cx, cy, str(int(n)), ha="center", va="center", fontsize=6.5,
+                         color="white" if n > np.sqrt(used.max() * used.min()) else "black")
+            if dec[j, i] == 2:
+                axes[0].text(cx, cy, "?", ha="center", va="center", fontsize=9)
+    handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in colors.colors]
+    labels = ["stable (≤ q unstable)", "unstable (> q)", "undecided (?)"]
+    if "spectral_radius" in sub:
+        holds = sub["spectral_radius"].transpose(yd, xd).values < 1.0
+        for ax in axes:
+            line = _outline(ax, holds, xe, ye, color="white", lw=2.5)
+        if line is not None:
+            handles.append(line)
+            labels.append("ρ(R(τÃ)) < 1 inside")
+    axes[0].legend(handles, labels, loc="upper right", fontsize=8, framealpha=0.9)
+    conf = ds.attrs.get("sequential_confidence", "")
+    q = ds.attrs.get("sequential_q", "")
+    for ax, what in zip(axes, ("decision", "members used")):
+        ax.set_xscale("log" if xlog else "linear")
+        ax.set_xlabel(_label(ds, xd))
+        if yd == "_row":
+            ax.set_yticks([])
+        else:
+            ax.set_yscale("log" if ylog else "linear")
+            ax.set_ylabel(_label(ds, yd))
+        ax.set_title(f"{what}" + (f" (q = {q}, confidence {conf})" if what == "decision"
+                                  else f", {int(used.sum())} in all"), fontsize=10)
+    title = (f"{ds.attrs.get('model', '')}: {ds.attrs.get('law', '')} law, "
+             f"{ds.attrs.get('scheme', '')} — each grid point run until decided")
+    if note:
+        title += f" (at {note})"
+    fig.suptitle(title, fontsize=10.5)
     fig.savefig(path, dpi=130)
     plt.close(fig)
     return path
@@ -299,11 +365,11 @@ def plot_dataset(dataset, output=None) -> list[Path]:
     try:
         if "tau_star" in ds:
             return [boundary_curve(ds, Path(f"{stem}_boundary.png"))]
-        return [
-            stability_map(ds, Path(f"{stem}_stability.png")),
-            decay_curves(ds, Path(f"{stem}_decay.png")),
-            beta_comparison(ds, Path(f"{stem}_beta.png")),
-        ]
+        pictures = [stability_map(ds, Path(f"{stem}_stability.png"))]
+        if "decision" in ds and _sweep_dims(ds):
+            pictures.append(decision_map(ds, Path(f"{stem}_decision.png")))
+        return pictures + [decay_curves(ds, Path(f"{stem}_decay.png")),
+                           beta_comparison(ds, Path(f"{stem}_beta.png"))]
     except (KeyError, AttributeError, IndexError, ValueError) as exc:
         written = str(ds.attrs.get("stabdae_version", "an unknown version"))
         if written == __version__:

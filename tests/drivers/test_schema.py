@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import stabdae
 from conftest import ROOT, assert_schema, load_scene, pendulum_scene
@@ -282,5 +283,14 @@ def test_every_kind_of_dataset_passes_the_cf_checker(tmp_path):
     stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=8, save_dt=0.01).to_netcdf(ens)
     study = run_study(study_file(tmp_path, members=8, t_end=0.2, omegas="5.0"),
                       progress=False, log=lambda *a: None)  # fmt: skip
-    for path in (traj, ens, study):
+    # grid points run until decided: the decision's codes, and members padded as not run
+    (tmp_path / "seq.toml").write_text(
+        '[model]\nfile = "pendulum"\n[law]\nkind = "baumgarte"\nomega = 50.0\n[run]\n'
+        't_end = 0.5\ntau = 0.01\n[ensemble]\nmembers = { batch = 16, max = 64 }\n'
+        '[sweep]\ntau = [0.01, 0.05]\n')  # fmt: skip
+    seq = run_study(tmp_path / "seq.toml", tmp_path / "seq.nc", progress=False,
+                    log=lambda *a: None)  # fmt: skip
+    with xr.open_dataset(seq) as ds:
+        assert ds.members_used.values.tolist() != [64, 64]  # (the padding is checked too)
+    for path in (traj, ens, study, seq):
         assert cf_findings(path) == CF_ACCEPTED, path.name

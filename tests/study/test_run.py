@@ -565,8 +565,14 @@ def test_ctrl_c_during_a_write_takes_effect_once_the_file_is_written(tmp_path, m
         return out
 
     monkeypatch.setattr(xr.Dataset, "to_netcdf", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        write_netcdf(ds, tmp_path / "a.nc")
+    # Python's own handler, as in a terminal (a test run started as a background job
+    # inherits SIGINT ignored)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            write_netcdf(ds, tmp_path / "a.nc")
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, before)
     with xr.open_dataset(tmp_path / "a.nc") as back:
         xr.testing.assert_identical(back.load(), ds)
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

@@ -7,9 +7,10 @@ minimum-norm step ``x⁰ = x* + G⁺α⁰``, ``G = ∂g/∂x`` ((2m + k) × 2n),
 least quarters the error, which for small α⁰ takes a step or two, and with ``G`` at the
 current state (Gauss–Newton) from the first step that does not.  ``G`` is formed by
 central differences of the compiled residual; an approximate Jacobian changes the path,
-not the target, since the residual itself is exact.  Random numbers come from a seeded
-``numpy.random.Generator`` in Python and enter the compiled code as arrays, so the result
-does not depend on the thread count.
+not the target, since the residual itself is exact.  Random numbers come from a
+counter-based generator in Python (:func:`draw_alphas`: member ``i``'s from the seed and
+``i`` alone) and enter the compiled code as arrays, so the result depends on neither the
+thread count nor the members run beside it.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import math
 
 import numpy as np
 from numba import njit
+from scipy.special import ndtri
 
 from .._codes import Status
 from .cache import Spec, keyed_cache, memo, tag
@@ -214,14 +216,39 @@ def build_residual_rows(K, spec: Spec):
     return keyed_cache(residual_rows, spec.key(K.key))
 
 
-def draw_alphas(ng: int, members: int, radius, rng: np.random.Generator) -> np.ndarray:
-    """Targets α⁰ (members × ng): directions uniform on the unit sphere, scaled so that the
-    max-norm ``‖α⁰‖∞`` (the paper's norm) is log-uniform in ``radius = (low, high)``."""
+def member_key(seed) -> np.ndarray:
+    """The Philox key (two 64-bit words) of ``seed``: a non-negative integer (through
+    :class:`numpy.random.SeedSequence`) or a ``numpy.random.Generator`` (two words drawn
+    from it)."""
+    if isinstance(seed, np.random.Generator):
+        return seed.integers(0, 2**64, size=2, dtype=np.uint64, endpoint=False)
+    return np.random.SeedSequence(int(seed)).generate_state(2, np.uint64)
+
+
+def draw_alphas(ng: int, members: int, radius, seed, start: int = 0) -> np.ndarray:
+    """Targets α⁰ of the members ``start … start + members − 1`` (members × ng): directions
+    uniform on the unit sphere, scaled so that the max-norm ``‖α⁰‖∞`` (the paper's norm)
+    is log-uniform in ``radius = (low, high)``.
+
+    Member ``i``'s target is a function of ``(seed, i)`` alone (common random numbers):
+    its ``ng + 1`` uniforms are the outputs of the counter-based Philox4x64 generator
+    (Salmon, Moraes, Dror and Shaw, "Parallel random numbers: as easy as 1, 2, 3", SC
+    2011; :class:`numpy.random.Philox`) at its own counters ``i·B … (i + 1)·B − 1``
+    (``B = ⌈(ng + 1)/4⌉``), turned into normals by the inverse normal distribution
+    function.  So member ``i`` is the same at every grid point of a study, in any batch
+    of members, at any thread count, and an ensemble extended by more members keeps the
+    ones it had."""
     low, high = radius
-    u = rng.standard_normal((members, ng))
-    u /= np.max(np.abs(u), axis=1, keepdims=True)
+    per = ng + 1
+    blocks = -(-per // 4)
+    raw = np.random.Philox(key=member_key(seed), counter=int(start) * blocks).random_raw(
+        4 * blocks * members).reshape(members, 4 * blocks)[:, :per]  # fmt: skip
+    # the 53 high bits, centred in their interval: uniforms in the open interval (0, 1)
+    u = ((raw >> np.uint64(11)).astype(np.float64) + 0.5) * 2.0**-53
+    d = ndtri(u[:, :ng])
+    d /= np.max(np.abs(d), axis=1, keepdims=True)
     if low == high:
         r = np.full(members, float(low))
     else:
-        r = np.exp(rng.uniform(math.log(low), math.log(high), members))
-    return u * r[:, None]
+        r = np.exp(math.log(low) + (math.log(high) - math.log(low)) * u[:, ng])
+    return d * r[:, None]

@@ -6,7 +6,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .._codes import Verdict, VerdictReason
+from .._codes import Status, Verdict, VerdictReason
+
+VERDICT_WORDS = {int(v): v.message for v in Verdict}
 
 __all__ = ["format_table", "grid_table", "summary"]
 
@@ -30,10 +32,12 @@ def format_table(ds: xr.Dataset, columns=None) -> str:
                       precise=("norm_weighted", "spectral_radius", "path_norm_weighted_max"))
 
 
-def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) -> str:
+def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=(),
+               codes=None) -> str:  # fmt: skip
     """One row per grid point of ``ds`` (its swept dimensions first, then ``columns``,
-    headed by ``short`` names): ``flags`` as yes/no, ``precise`` with 6 digits (the ones
-    that decide "< 1"), the rest with 4."""
+    headed by ``short`` names): ``flags`` as yes/no, ``codes`` (column → {code: word}) as
+    words, ``precise`` with 6 digits (the ones that decide "< 1"), the rest with 4."""
+    codes = codes or {}
     dims = list(ds[columns[0]].dims)
     flat = ds[columns].stack(point=dims) if dims else ds[columns].expand_dims(point=[0])
     head = [d.split(".", 1)[-1] for d in dims] + [short.get(c, c) for c in columns]
@@ -44,6 +48,8 @@ def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=()) ->
             v = float(flat[c].values[i])
             if c in flags:
                 row.append("yes" if v == 1 else "no")
+            elif c in codes:
+                row.append(codes[c].get(int(v), str(v)))
             else:
                 row.append(f"{v:.6g}" if c in precise else f"{v:.4g}")
         rows.append(row)
@@ -67,13 +73,15 @@ def summary(ds: xr.Dataset) -> str:
                 "ensemble) and high; tau_floor: Theorems 6/7 with the floor the local error "
                 "forces; tau_spectral: rho(R) = 1):")  # fmt: skip
         return "\n" + head + "\n" + grid_table(ds, cols, short, precise=cols[:5]) + "\n"
-    cols = [c for c in ("fraction_stable", "fraction_unstable", "fraction_undecided",
+    cols = [c for c in ("decision", "members_used",
+                        "fraction_stable", "fraction_unstable", "fraction_undecided",
                         "fraction_bounded",
                         "stability_radius",
                         "beta_median", "members_with_beta", "beta_ratio_median",
                         "beta_theory_discrete", "spectral_radius", "norm_condition",
                         "beta_theorem5_proven", "beta_theorem5_printed") if c in ds]  # fmt: skip
-    short = {"fraction_stable": "stable", "fraction_unstable": "unstable",
+    short = {"decision": "decision", "members_used": "n",
+             "fraction_stable": "stable", "fraction_unstable": "unstable",
              "fraction_undecided": "undecided",
              "fraction_bounded": "bounded",
              "stability_radius": "delta*", "beta_median": "beta_med",
@@ -81,12 +89,15 @@ def summary(ds: xr.Dataset) -> str:
              "beta_theory_discrete": "beta_pred", "spectral_radius": "rho(R)",
              "norm_condition": "cond", "beta_theorem5_proven": "b5_proven",
              "beta_theorem5_printed": "b5_printed"}  # fmt: skip
-    head = ("summary (stable, unstable, undecided, bounded: fractions of members "
+    head = ("summary (" + ("decision: the grid point's, at the stated confidence (see "
+                           "decision_reason), after n members; " if "decision" in ds else "")
+            + "stable, unstable, undecided, bounded: fractions of members "
             "(undecided: the run "
             "cannot tell, see verdict_reason); delta*: stability radius; "
             "n_beta: members with a measured beta; meas/lin: median of measured over the "
             "linear prediction's beta; beta_pred = -ln rho(R)/tau):")  # fmt: skip
-    table = grid_table(ds, cols, short, flags=("norm_condition",))
+    table = grid_table(ds, cols, short, flags=("norm_condition",),
+                       codes={"decision": VERDICT_WORDS})
     return "\n" + head + "\n" + table + "\n" + unstable_below_one(ds)
 
 
@@ -97,7 +108,8 @@ def unstable_below_one(ds: xr.Dataset) -> str:
     if not {"spectral_radius", "verdict", "verdict_reason"} <= set(ds.variables):
         return ""
     dims = list(ds.spectral_radius.dims)
-    flat = ds[["spectral_radius", "verdict", "verdict_reason"]]
+    flat = ds[["spectral_radius", "verdict", "verdict_reason"]
+              + (["status"] if "status" in ds else [])]
     flat = flat.stack(point=dims) if dims else flat.expand_dims(point=[0])
     lines = []
     for i in range(flat.sizes["point"]):
@@ -112,8 +124,11 @@ def unstable_below_one(ds: xr.Dataset) -> str:
                                     return_counts=True)  # fmt: skip
         why = "; ".join(f"{c} {VerdictReason(int(r)).message.split(':')[0]}"
                         for r, c in zip(reasons, counts))  # fmt: skip
+        ran = verdict.size
+        if "status" in flat:  # (a grid point run until decided: its own members only)
+            ran = int((flat.status.isel(point=i).values != int(Status.NOT_NEEDED)).sum())
         lines.append(f"  {where}: rho(R) = {rho:.4g} < 1, yet {int(unstable.sum())} of "
-                     f"{verdict.size} members unstable ({why})")
+                     f"{ran} members unstable ({why})")
     if not lines:
         return ""
     return ("\nunstable where the law's linear part is stable (rho(R) < 1: what grows there "

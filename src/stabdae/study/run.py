@@ -36,7 +36,7 @@ from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
 from ..engine.cache import function_fingerprint, library_fingerprint
 from .report import summary
-from .spec import Study, StudyError, load_study
+from .spec import Study, StudyError, load_study, members_text, most_members
 from .store import Manifest, Store, clear, stack
 from .theory import axis_units, for_study
 
@@ -360,7 +360,7 @@ def combine(study: Study, tables: list[Table]) -> xr.Dataset:
     ds.attrs["created_at"] = utc_now()
     what = "boundary searches" if study.search is not None else "grid points"
     append_history(ds.attrs, f"stabdae run {study.path.name}: {len(tables)} {what} of "
-                   f"{study.ensemble['members']} members combined")  # fmt: skip
+                   f"{members_text(study.ensemble['members'])} combined")  # fmt: skip
     return ds
 
 
@@ -393,7 +393,7 @@ def _work_per_point(study: Study) -> int:
     beside the spectral limit, the bisection from the whole bracket down to ``rtol``,
     each of ``search_members``, and the full ensemble's confirmation), so that the bar
     moves, and its time left is estimated, per probe (:meth:`_Progress.note`)."""
-    members = int(study.ensemble["members"])
+    members = most_members(study.ensemble["members"])
     if study.search is None:
         return members
     s = study.search

@@ -24,6 +24,7 @@ from .._laws import Law, LawError, baumgarte, matrix, none, theorem5
 from .._loading import load_model, model_file
 from .._model import Model, ModelError
 from .._schemes import Scheme, SchemeError, as_scheme, from_tableau
+from .._sequential import Sequential
 from .._validate import block, ensemble_bytes, fits_in_memory, fixed_time_grid
 
 __all__ = ["Study", "StudyError", "load_study"]
@@ -40,7 +41,7 @@ _SECTIONS = {
                "order": int},
     "run": {"t_end": float, "tau": float, "save_dt": float, "epsilon": float,
             "divergence": float},  # fmt: skip
-    "ensemble": {"members": int, "radius": (list, float), "seed": int, "block": int,
+    "ensemble": {"members": (int, dict), "radius": (list, float), "seed": int, "block": int,
                  "states": bool},
     "sweep": None,  # names checked against the other sections
     "search": {"tau": dict, "q": float, "search_members": int, "steps": int,
@@ -137,14 +138,29 @@ class Study:
     def describe(self) -> str:
         axes = ", ".join(f"{k} ({len(v)})" for k, v in self.axes.items()) or "none"
         head = (f"study {self.path.name}: model {self.model.name}, law {self.law['kind']}, "
-                f"scheme {self.scheme.get('name', 'rk2')}, {self.ensemble['members']} members "
-                f"× {self.size} grid points; swept: {axes}")  # fmt: skip
+                f"scheme {self.scheme.get('name', 'rk2')}, "
+                f"{members_text(self.ensemble['members'])} × {self.size} grid points; "
+                f"swept: {axes}")  # fmt: skip
         if self.search is not None:
             s = self.search
             head += (f"; searched: tau in [{s['tau'][0]:g}, {s['tau'][1]:g}] to rtol "
                      f"{s['rtol']:g} (probes of {s['search_members']} members, confirmed "
                      f"with {self.ensemble['members']})")  # fmt: skip
         return "\n".join([head, *self.notes])
+
+
+def most_members(members) -> int:
+    """The most members a grid point runs: ``members``, or a sequential plan's ``max``."""
+    return int(members["max"] if isinstance(members, dict) else members)
+
+
+def members_text(members) -> str:
+    """``members`` in words: "256 members", or "64 … 1024 members until decided (q = …,
+    confidence …)"."""
+    if not isinstance(members, dict):
+        return f"{members} members"
+    return (f"{members['batch']} … {members['max']} members until decided (q = "
+            f"{members['q']:g} at confidence {members['confidence']:g})")
 
 
 def _make_law(law: dict, A) -> Law:
@@ -279,11 +295,20 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
     ens.update(raw.get("ensemble", {}))
     if members is not None:
         ens["members"] = members
-    if ens["members"] < 1:
+    if isinstance(ens["members"], dict):  # run until decided (one plan for every point)
+        if searching:
+            fail("[ensemble] members", "a boundary search runs its probes with a number of "
+                 "members: give an integer")  # fmt: skip
+        try:
+            ens["members"] = Sequential.of(ens["members"], "load_study").as_dict()
+        except ValueError as exc:
+            fail("[ensemble] members", str(exc).removeprefix("load_study: members "))
+    elif ens["members"] < 1:
         fail("[ensemble] members", f"must be at least 1, got {ens['members']}")
+    most = most_members(ens["members"])
     try:  # before any grid point: refused up front, not killed part-way
-        fits_in_memory(ensemble_bytes(model.n, model.n_residual, ens["members"], 0, 0, 4),
-                       f"{ens['members']} members per grid point", "load_study",
+        fits_in_memory(ensemble_bytes(model.n, model.n_residual, most, 0, 0, 4),
+                       f"{most} members per grid point", "load_study",
                        "run fewer members")  # fmt: skip
     except MemoryError as exc:
         fail("[ensemble] members", str(exc).removeprefix("load_study: "))

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .._ensemble_dataset import Table
+from .._ensemble_dataset import NOT_RUN, Table
 from .._loading import file_sha256
 from .._schema import cf_dataset, deferred_interrupt
 
@@ -338,6 +338,32 @@ def common_attrs(many: list[dict]) -> dict:
     return out
 
 
+def _padded_sizes(tables: list[Table]) -> dict:
+    """The dimensions whose sizes differ between the tables (grid points run until
+    decided ran different numbers of members): ``{dim: (largest size, its table)}``."""
+    seen: dict = {}
+    for i, t in enumerate(tables):
+        for vdims, values, _ in t.data.values():
+            for d, n in zip(_dims(vdims), np.shape(values)):
+                seen.setdefault(d, {})[i] = n
+    out = {}
+    for d, per in seen.items():
+        if len(set(per.values())) > 1:
+            owner = max(per, key=per.get)
+            out[d] = (per[owner], owner)
+    return out
+
+
+def _padded(name: str, vdims: tuple, values: np.ndarray, sizes: dict) -> np.ndarray:
+    """``values`` padded to ``sizes`` along its dimensions: NaN for real numbers, a
+    member's not-run code (:data:`.._ensemble_dataset.NOT_RUN`) or 0 for integers."""
+    pad = [(0, sizes[d][0] - n if d in sizes else 0) for d, n in zip(vdims, values.shape)]
+    if not any(p[1] for p in pad):
+        return values
+    fill = np.nan if values.dtype.kind in "fc" else NOT_RUN.get(name, 0)
+    return np.pad(values, pad, constant_values=fill)
+
+
 def stack(tables: list[Table], axes: dict[str, np.ndarray]) -> xr.Dataset:
     """One dataset of the grid's tables (C order over ``axes``, dimension name → values):
     every variable gains the axes as its leading dimensions; the coordinates are the first
@@ -346,13 +372,20 @@ def stack(tables: list[Table], axes: dict[str, np.ndarray]) -> xr.Dataset:
     dims = tuple(axes)
     shape = tuple(len(v) for v in axes.values())
     first = tables[0]
+    sizes = _padded_sizes(tables)
     data = {}
     for name, (vdims, _, _) in first.data.items():
-        column = np.stack([np.asarray(t.data[name][1]) for t in tables])
+        vd = tuple(_dims(vdims))
+        column = np.stack([_padded(name, vd, np.asarray(t.data[name][1]), sizes)
+                           for t in tables])  # fmt: skip
         attrs = common_attrs([t.data[name][2] for t in tables])
-        data[name] = xr.Variable(dims + tuple(_dims(vdims)),
-                                 column.reshape(shape + column.shape[1:]), attrs)  # fmt: skip
+        data[name] = xr.Variable(dims + vd, column.reshape(shape + column.shape[1:]),
+                                 attrs)  # fmt: skip
     coords = dict(first.coords)
+    for d, (_, owner) in sizes.items():  # the coordinates of the longest
+        for k, c in tables[owner].coords.items():
+            if d in c.dims:
+                coords[k] = c
     for d, values in axes.items():
         coords[d] = xr.Variable(d, np.asarray(values))
     ds = cf_dataset(data, coords=coords, attrs=common_attrs([t.attrs for t in tables]))

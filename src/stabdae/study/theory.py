@@ -24,6 +24,7 @@ from ..theory import (
     tau_limit,
     theorem5,
 )
+from .spec import most_members
 
 __all__ = ["axis_units", "for_study"]
 
@@ -80,7 +81,7 @@ def for_study(study, *, path_steps: int = 2000) -> xr.Dataset:
         else:
             if neighbourhood is None or any(n.startswith("model.") for n in names):
                 x_ref = model.reference_state(p)
-                ens = sample_perturbations(model, study.ensemble["members"],
+                ens = sample_perturbations(model, most_members(study.ensemble["members"]),
                                            study.ensemble["radius"], study.ensemble["seed"],
                                            params=p)[0]  # fmt: skip
                 traj = integrate(model, x_ref, law, scheme, tau, s["t_end"], s["save_dt"],
