@@ -27,7 +27,8 @@ from __future__ import annotations
 import re
 from enum import IntEnum
 
-__all__ = ["BetaReason", "DecisionReason", "FitKind", "LawKind", "ProbeStage", "Status",
+__all__ = ["BetaReason", "DecisionReason", "FitKind", "LawKind", "ProbeStage", "ProfileReason",
+           "Status",
            "StabilityClass", "TauStarReason", "RadiusReason", "Verdict", "VerdictReason",
            "flag_attrs"]  # fmt: skip
 
@@ -149,6 +150,22 @@ class RadiusReason(_Codes):
     BELOW_SAMPLE = 2, ("< smallest sampled: no member stable below the smallest unstable; "
                        "stability_radius_high is its |alpha0|")
     NO_MEMBER = 3, "no decided member: every member undecided or not run"
+
+
+class ProfileReason(_Codes):
+    """How the bracket of δ* from a radial profile is known (``delta_star_reason``,
+    :func:`stabdae.radial_profile`)."""
+
+    BRACKETED = 0, ("bracketed: every bin up to delta_star_low is shown stable often "
+                    "enough, the bin that ends at delta_star_high is shown not to be")
+    ABOVE_SAMPLE = 1, ("above the sample: every bin is shown stable often enough; "
+                       "delta_star_low is the largest radius binned")
+    BELOW_SAMPLE = 2, ("below the sample: the first bin is shown not stable often enough; "
+                       "delta_star_high is its top")
+    OPEN_ABOVE = 3, ("open above: no bin above delta_star_low is shown either way (more "
+                     "members, or fewer bins, narrow it)")
+    OPEN_BELOW = 4, ("open below: the first bins are shown neither way, a later one not "
+                     "stable often enough (more members, or fewer bins, narrow it)")
 
 
 class Verdict(_Codes):

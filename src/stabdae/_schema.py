@@ -35,6 +35,7 @@ from ._codes import (
     DecisionReason,
     FitKind,
     ProbeStage,
+    ProfileReason,
     RadiusReason,
     StabilityClass,
     Status,
@@ -136,6 +137,8 @@ SCHEMA: dict[str, tuple] = {
     "decision_high": ((), "sequential interval of the unstable fraction, high (from the "
                       "members not stable: unstable or undecided)", "1", {}),
     "members_used": ((), "members run before the decision", "1", {}),
+    "delta_star_reason": ((), "how the delta* bracket of a radial profile is known "
+                          "(stabdae.radial_profile)", "1", flag_attrs(ProfileReason)),
     "fraction_stable": ((), "fraction of stable members (of those that ran)", "1", {}),
     "fraction_stable_low": ((), "Wilson 95% interval of fraction_stable, low", "1", {}),
     "fraction_stable_high": ((), "Wilson 95% interval of fraction_stable, high", "1", {}),
@@ -340,7 +343,8 @@ _CODE_VARIABLES = (("status", Status), ("beta_reason", BetaReason), ("fit_kind",
                    ("decision", Verdict), ("decision_reason", DecisionReason),
                    ("stability_class", StabilityClass),
                    ("stability_radius_reason", RadiusReason),
-                   ("tau_star_reason", TauStarReason), ("probe_stage", ProbeStage))  # fmt: skip
+                   ("tau_star_reason", TauStarReason), ("probe_stage", ProbeStage),
+                   ("delta_star_reason", ProfileReason))  # fmt: skip
 
 
 # --------------------------------------------------------------------- units

@@ -27,7 +27,7 @@ import xarray as xr
 from ._version import __version__
 
 __all__ = ["plot_dataset", "stability_map", "decision_map", "decay_curves",
-           "beta_comparison", "boundary_curve"]
+           "beta_comparison", "boundary_curve", "profile_curve"]
 
 
 def _plt():
@@ -438,5 +438,39 @@ def boundary_curve(ds: xr.Dataset, path: Path) -> Path:
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8)
     fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def profile_curve(profile: xr.Dataset, path: Path, reference: float | None = None) -> Path:
+    """A radial profile (:func:`stabdae.radial_profile`): the fraction of members stable
+    per bin of ``‖α⁰‖∞`` with its interval, the line ``1 − q``, and δ*'s bracket shaded
+    (``reference``: a radius to mark, e.g. an independent estimate)."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.2, 4.4), constrained_layout=True)
+    lo, hi = profile.radius_low.values, profile.radius_high.values
+    centre = np.sqrt(lo * hi)
+    frac = profile.fraction_stable.values
+    err = [frac - profile.fraction_stable_low.values, profile.fraction_stable_high.values - frac]
+    ax.errorbar(centre, frac, yerr=err, xerr=[centre - lo, hi - centre], fmt="o", ms=4,
+                capsize=2, label="fraction stable per bin, with its interval")  # fmt: skip
+    q = float(profile.attrs["q"])
+    ax.axhline(1 - q, color="gray", lw=1, ls="--", label=f"1 − q = {1 - q:g}")
+    d_low, d_high = float(profile.delta_star_low), float(profile.delta_star_high)
+    span = (d_low if np.isfinite(d_low) else lo[0], d_high if np.isfinite(d_high) else hi[-1])
+    ax.axvspan(*span, color="tab:orange", alpha=0.2,
+               label=f"δ* bracket [{d_low:.3g}, {d_high:.3g}]")  # fmt: skip
+    if reference is not None:
+        ax.axvline(reference, color="black", lw=1.2, label=f"bisection: {reference:.3g}")
+    ax.set_xscale("log")
+    ax.set_ylim(-0.03, 1.03)
+    units = profile.radius_low.attrs.get("units", "")
+    ax.set_xlabel(f"initial perturbation |α⁰|∞{f' [{units}]' if units else ''}")
+    ax.set_ylabel("fraction of members stable")
+    conf = profile.attrs.get("confidence", "")
+    head = " ".join(str(profile.attrs.get(k, "")) for k in ("model", "law", "scheme"))
+    ax.set_title(f"{head} — radial profile (intervals together at {conf})", fontsize=10)
+    ax.legend(fontsize=8.5, loc="lower left")
+    fig.savefig(path, dpi=130)
     plt.close(fig)
     return path

@@ -15,7 +15,8 @@ from stabdae._schema import _CODE_VARIABLES, SCHEMA, schema_markdown
 from stabdae.engine import decay, rhs
 
 FAMILIES = [_codes.Status, _codes.BetaReason, _codes.FitKind, _codes.StabilityClass,
-            _codes.TauStarReason, _codes.ProbeStage, _codes.LawKind]  # fmt: skip
+            _codes.TauStarReason, _codes.ProbeStage, _codes.LawKind, _codes.DecisionReason,
+            _codes.ProfileReason]  # fmt: skip
 
 
 @pytest.mark.parametrize("family", FAMILIES, ids=lambda f: f.__name__)

@@ -199,7 +199,7 @@ def test_condition4_with_a_non_symmetric_map_and_constant_forcing():
     for _ in range(400):
         g.append(R @ g[-1] + e)
     g = np.array(g)
-    out = theory.condition4(R, g)
+    out = theory.condition4(R, g, weight="lyapunov")
     n = R.shape[0]
     X = np.linalg.solve(np.kron(R.T, R.T) - np.eye(n * n), -np.eye(n).ravel()).reshape(n, n)
     P = np.real(sqrtm(0.5 * (X + X.T)))
@@ -213,6 +213,31 @@ def test_condition4_with_a_non_symmetric_map_and_constant_forcing():
     start = np.linalg.norm(Pinv, 2) * np.linalg.norm(P @ g[0])
     assert out["start"] == pytest.approx(start, rel=1e-10)
     assert np.abs(g).max(axis=1).max() <= max(out["start"], out["epsilon"])
+    # the weight chosen for the smallest floor: no larger, and its bound holds too
+    best = theory.condition4(R, g)
+    assert best["epsilon"] <= out["epsilon"] and best["q"] < 1.0
+    assert np.abs(g).max(axis=1).max() <= max(best["start"], best["epsilon"])
+    P = best["weight"]
+    assert best["q"] == pytest.approx(np.linalg.norm(P @ R @ np.linalg.inv(P), 2), rel=1e-12)
+
+
+def test_the_floor_weight_follows_the_contraction_not_the_components_sizes():
+    """The pendulum under ω = 300 (ξ = 1), midpoint, τω = 1.5: ρ(R) = 0.625, but the
+    weight of RᵀXR − X = −I weighs ḟ (of size ω f) like f and has q = 0.999998, so its
+    floor is 20,000 times the residual.  The chosen weight contracts at q < 0.9 and
+    bounds the floor four decades lower; both bounds hold along the reference path (the
+    theorems' claim: ‖g_k‖∞ ≤ max(start, ε) for g_{k+1} = R g_k + e_k)."""
+    model, law, tau = load_scene("pendulum"), stabdae.baumgarte(300.0, 1.0), 0.005
+    R = theory.step_matrix(law.A_tilde(model), "midpoint", tau)
+    g = stabdae.integrate(model, None, law, "midpoint", tau, 2000 * tau, tau).residual.values
+    plain, best = theory.condition4(R, g, weight="lyapunov"), theory.condition4(R, g)
+    assert theory.spectral_radius(R) == pytest.approx(0.625)
+    assert plain["q"] > 0.99999 and best["q"] < 0.9
+    assert best["epsilon"] < 1e-4 * plain["epsilon"]
+    for out in (plain, best):
+        assert np.abs(g).max(axis=1).max() <= max(out["start"], out["epsilon"])
+    with pytest.raises(ValueError, match="condition4: weight must be 'best' or 'lyapunov'"):
+        theory.condition4(R, g, weight="identity")
 
 
 def test_roundoff_growing_with_the_state_is_not_growth():
