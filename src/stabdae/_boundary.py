@@ -38,6 +38,7 @@ from ._measures import (
     ensemble_verdict,
 )
 from ._schema import cf_dataset, provenance, schema_variable, variable
+from ._sequential import MIN_BATCH, Sequential
 from .engine.ensemble.block import BLOCK
 
 __all__ = ["boundary", "floor_limit"]
@@ -75,6 +76,7 @@ def boundary(
     block: int = BLOCK,
     threads: int | None = None,
     progress=False,
+    confidence: float | None = None,
 ) -> xr.Dataset:
     """The largest step size τ* at which an ensemble is stable, to a relative ``rtol``.
 
@@ -111,6 +113,16 @@ def boundary(
         As for :func:`stabdae.ensemble`; every probe draws the same perturbations.
     progress : bool or callable ``(text)``
         ``True`` prints a line per probe on stderr; a callable receives that line.
+    confidence : float, optional
+        Decide every probe at a confidence instead (needs ``q > 0``): each probe runs
+        members until it is decided, at most ``members`` (:class:`stabdae.Sequential`,
+        first look ``search_members``, at least 16), with the error budget
+        ``1 − confidence`` split evenly over the most probes the search can take (the
+        bracket's ends, two beside the spectral limit, the bisection down to ``rtol``).
+        With probability at least ``confidence`` every decision is right, and the
+        unstable fraction crosses ``q`` between ``tau_star_low`` and ``tau_star_high``
+        (``tau_star_confidence``); no confirmation stage follows (each probe already
+        ran the members its decision needed).
 
     Returns
     -------
@@ -162,6 +174,17 @@ def boundary(
     low_r, high_r = check.radius(radius, who)
     epsilon = 10.0 * high_r if epsilon is None else check.positive(epsilon, "epsilon", who)
     say = _reporter(progress, who)
+    plan = None
+    if confidence is not None:
+        if not q > 0.0:
+            raise ValueError(f"{who}: with confidence, q must be above 0 (no number of "
+                             "members shows a fraction to be 0)")  # fmt: skip
+        most = 4 + math.ceil(math.log2(max(2.0, math.log(hi / lo) / math.log1p(rtol)))) + 1
+        confidence = check.real(confidence, "confidence", who)
+        plan = Sequential.of({"confidence": 1.0 - (1.0 - confidence) / most
+                              if 0.0 < confidence < 1.0 else confidence, "q": q,
+                              "max": members,
+                              "batch": min(members, max(MIN_BATCH, search_members))}, who)
 
     probes: list[tuple] = []
 
@@ -173,13 +196,17 @@ def boundary(
         t = t if t_end is None else span / k
         with warnings.catch_warnings():  # stopped members are what the probe counts
             warnings.simplefilter("ignore", IntegrationWarning)
-            ds = ensemble(model, law, scheme, t, model.t0 + k * t, members=n,
+            ds = ensemble(model, law, scheme, t, model.t0 + k * t,
+                          members=n if plan is None else plan,
                           radius=(low_r, high_r), seed=seed, save_dt=k * t, params=p,
                           epsilon=epsilon, divergence=divergence, block=block,
                           threads=threads, traces="none")  # fmt: skip
         frac = float(ds.fraction_stable)
-        v = ensemble_verdict(int(ds.members_run), int(ds.members_stable),
-                             int(ds.members_unstable), q)  # fmt: skip
+        if plan is None:
+            v = ensemble_verdict(int(ds.members_run), int(ds.members_stable),
+                                 int(ds.members_unstable), q)  # fmt: skip
+        else:  # the sequential decision; the members it took
+            v, n = int(ds.decision), int(ds.members_used)
         probes.append((t, n, frac, v, stage, ds))
         say(f"{who}: tau = {t:.6g} {VERDICTS[v].upper() if v != V_STABLE else 'stable'} "
             f"({int(ds.members_stable)} stable, {int(ds.members_unstable)} unstable, "
@@ -220,6 +247,8 @@ def boundary(
         good, bad, decided = _bisect(probe, good, bad, rtol, search_members)
         if not decided:
             reason = PROBE_UNDECIDED
+        elif plan is not None:
+            pass  # every probe was decided at the plan's confidence: nothing to confirm
         # the full ensemble at the largest stable step; where it fails, step down
         # (doubling the step, the last step down to the bracket's low end itself) until
         # it passes, then bisect again with the full ensemble
@@ -252,7 +281,7 @@ def boundary(
     top = min(bad, limits["tau_limit_spectral"]) if good <= limits["tau_limit_spectral"] \
         else bad  # fmt: skip
     star = math.sqrt(good * top) if reason == BRACKETED else math.nan
-    at = _last(probes, good, members)
+    at = _last(probes, good, None if plan is not None else members)
     floor = (floor_limit(model, law, scheme, epsilon, steps=steps if t_end is None else None,
                          t_end=t_end, params=p, rtol=rtol,
                          tau_max=limits["tau_limit_spectral"])
@@ -261,7 +290,9 @@ def boundary(
         tau_star=star, tau_star_low=good, tau_star_high=bad, reason=reason, probes=probes,
         at=at, floor=floor, limits=limits, A=A, rtol=rtol, q=q, steps=steps,
         members=members, search_members=search_members, seed=seed, radius=(low_r, high_r),
-        epsilon=epsilon, bracket=(lo, hi)))  # fmt: skip
+        epsilon=epsilon, bracket=(lo, hi),
+        confidence=math.nan if plan is None else confidence,
+        probe_confidence=math.nan if plan is None else plan.confidence))  # fmt: skip
 
 
 def _bisect(probe, good, bad, rtol, n, stage=BISECTION):
@@ -283,9 +314,10 @@ def _bisect(probe, good, bad, rtol, n, stage=BISECTION):
 
 
 def _last(probes, t, n):
-    """The full-ensemble probe at step ``t`` (None when there is none)."""
+    """The full-ensemble probe at step ``t`` (``n`` None: any probe at ``t``; None when
+    there is none)."""
     for pt, pn, _, _, _, ds in reversed(probes):
-        if pt == t and pn == n:
+        if pt == t and (n is None or pn == n):
             return ds
     return None
 
@@ -382,6 +414,7 @@ def _dataset(model, p, law, scheme, r) -> xr.Dataset:
     data = {name: schema_variable(name, val, model, dims=())
             for name, val in scalars.items()}  # fmt: skip
     data["tau_star_reason"] = schema_variable("tau_star_reason", np.int8(r["reason"]), model)
+    data["tau_star_confidence"] = schema_variable("tau_star_confidence", r["confidence"], model)
     columns = {
         "probe_tau": [x[0] for x in probes], "probe_members": [x[1] for x in probes],
         "probe_fraction_stable": [x[2] for x in probes],
@@ -398,5 +431,7 @@ def _dataset(model, p, law, scheme, r) -> xr.Dataset:
                  radius_low=r["radius"][0], radius_high=r["radius"][1],
                  epsilon=r["epsilon"], bracket_low=r["bracket"][0],
                  bracket_high=r["bracket"][1])  # fmt: skip
+    if math.isfinite(r["probe_confidence"]):
+        attrs["probe_confidence"] = r["probe_confidence"]
     coords = {"probe": variable("probe", np.arange(len(probes)), "probe index", "1")}
     return cf_dataset(data, coords=coords, attrs=attrs)

@@ -137,6 +137,10 @@ SCHEMA: dict[str, tuple] = {
     "decision_high": ((), "sequential interval of the unstable fraction, high (from the "
                       "members not stable: unstable or undecided)", "1", {}),
     "members_used": ((), "members run before the decision", "1", {}),
+    "tau_star_confidence": ((), "probability, at least, that every probe of the boundary "
+                            "search was decided right and the unstable fraction crosses q "
+                            "between tau_star_low and tau_star_high (NaN: probes of a fixed "
+                            "size, no stated confidence)", "1", {}),
     "delta_star_reason": ((), "how the delta* bracket of a radial profile is known "
                           "(stabdae.radial_profile)", "1", flag_attrs(ProfileReason)),
     "fraction_stable": ((), "fraction of stable members (of those that ran)", "1", {}),
@@ -261,7 +265,8 @@ _GROUPS = (
         "stability_radius_reason", "beta_median", "beta_median_low", "beta_median_high",
         "beta_median_coverage", "beta_ratio_median", "members_run", "members_stable",
         "members_unstable", "members_undecided", "members_bounded", "members_diverged",
-        "members_growing", "members_with_beta",
+        "members_growing", "members_with_beta", "decision", "decision_reason",
+        "decision_low", "decision_high", "members_used",
         "overshoot_theory", "beta_theory", "beta_theory_discrete",
         "spectral_radius", "norm_max", "norm_weighted", "norm_condition", "lambda_min_W",
         "beta_theorem5_proven", "beta_theorem5_printed", "gamma_theorem5",
@@ -275,7 +280,8 @@ _GROUPS = (
         "theorem5_beta_printed", "theorem5_gamma_factor", "path_spectral_radius_max",
         "path_norm_weighted_max", "path_epsilon")),
     ("A boundary search: `boundary` (and per grid point, `stabdae run` with `[search]`)", (
-        "tau_star", "tau_star_low", "tau_star_high", "tau_star_reason", "fraction_stable",
+        "tau_star", "tau_star_low", "tau_star_high", "tau_star_reason", "tau_star_confidence",
+        "fraction_stable",
         "fraction_stable_low", "fraction_stable_high", "members_run", "members_stable",
         "members_unstable", "members_undecided", "members_diverged", "members_growing",
         "tau_limit_spectral", "tau_limit_weighted_norm", "tau_limit_floor", "spectral_radius",

@@ -259,3 +259,16 @@ def test_a_sequential_study_resumes_and_rebatches_to_the_same_members(tmp_path, 
             if "member" in var.dims:
                 a, b = var.isel(tau=k, member=slice(0, n)), other[name].isel(tau=k)[:n]
                 assert np.array_equal(a.values, b.values, equal_nan=True), name
+
+
+def test_a_bad_plan_in_a_study_file_is_refused_by_its_key(tmp_path):
+    from stabdae.study.spec import StudyError, load_study
+
+    (tmp_path / "s.toml").write_text(SEQUENTIAL_STUDY.replace("batch = 32", "batch = 8"))
+    with pytest.raises(StudyError, match=r"\[ensemble\] members: batch must be an integer "
+                                         r"of at least 16, got 8"):  # fmt: skip
+        load_study(tmp_path / "s.toml")
+    text = SEQUENTIAL_STUDY.replace("batch = 32", "batch = 32, maximum = 5")
+    (tmp_path / "s.toml").write_text(text)
+    with pytest.raises(StudyError, match=r"\[ensemble\] members: .*has no key 'maximum'"):
+        load_study(tmp_path / "s.toml")

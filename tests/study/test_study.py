@@ -449,6 +449,14 @@ def test_a_theorem5_search_study_has_no_path_theory(tmp_path):
     (("rtol = 0.05", "rtol = 5.0"), r"\[search\] tau.rtol: must lie in"),
     (("omega = [10.0, 100.0]", "tau = [0.1, 0.2]"), r"\[sweep\] tau: is searched"),
     (("search_members = 8", "search_members = 8\nq = 1.0"), r"\[search\] q:"),
+    (("search_members = 8", "search_members = 8\nconfidence = 0.95"),
+     r"\[search\] confidence: needs q above 0"),
+    (("search_members = 8", "search_members = 8\nq = 0.05\nconfidence = 1.5"),
+     r"\[search\] confidence: must lie between 0 and 1"),
+    (("members = 16", "members = { max = 64 }"),
+     r"\[ensemble\] members: a boundary search runs its probes with a number of members"),
+    (("members = 16", "members = { max = 64, batch = 4 }"),
+     r"\[ensemble\] members: a boundary search"),
 ])  # fmt: skip
 def test_search_validation(tmp_path, edit, message):
     path = write(tmp_path, SEARCH.replace(*edit))

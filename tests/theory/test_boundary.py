@@ -375,3 +375,23 @@ def test_recommended_gain_is_the_published_value_and_the_brute_force_minimum(sch
     assert rec["rho_holonomic"] <= grid + 1e-9
     first = min(abs(step(np.array([[-x]]))[0, 0]) for x in np.linspace(0.0, 6.0, 6001))
     assert rec["rho_first_order"] <= first + 1e-9
+
+
+@pytest.mark.parametrize("scheme", ["euler", "rk4"])
+def test_a_search_decided_at_a_confidence_brackets_the_affine_limit(scheme):
+    """Every probe run until decided, the budget split over the probes the search can
+    take: the bracket holds the spectral limit (exact for the affine system), the
+    confidence is stored, and no probe ran more members than it needed (stable probes
+    stop at the first look that can show it, unstable ones at the first)."""
+    ds = stabdae.boundary(affine, AFFINE_LAW, scheme, tau=(0.02, 1.0), rtol=1e-3,
+                          members=1024, search_members=32, q=0.05, confidence=0.95)
+    spectral = theory.tau_limit(AFFINE_LAW.A_tilde(affine), scheme)
+    assert int(ds.tau_star_reason) == BRACKETED
+    assert float(ds.tau_star_low) <= spectral <= float(ds.tau_star_high)
+    assert float(ds.tau_star_high) <= float(ds.tau_star_low) * 1.001
+    assert float(ds.tau_star_confidence) == 0.95 and ds.attrs["probe_confidence"] > 0.99
+    used = ds.probe_members.values
+    assert set(used[ds.probe_stable.values == 0]) == {32}
+    assert used.max() < 1024 and (ds.probe_stage.values != 3).all()  # no confirmation
+    with pytest.raises(ValueError, match="boundary: with confidence, q must be above 0"):
+        stabdae.boundary(affine, AFFINE_LAW, scheme, tau=(0.02, 1.0), confidence=0.95)

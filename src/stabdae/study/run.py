@@ -100,7 +100,8 @@ def search_point(study: Study, s: dict, threads=None, progress=None) -> Table:
                   t_end=search["t_end"], radius=tuple(ens["radius"]), seed=ens["seed"],
                   params=s["params"], epsilon=s["epsilon"], divergence=s["divergence"],
                   block=ens["block"], threads=threads,
-                  progress=progress if callable(progress) else False)  # fmt: skip
+                  progress=progress if callable(progress) else False,
+                  confidence=search.get("confidence"))  # fmt: skip
     return Table.from_dataset(ds)
 
 

@@ -45,7 +45,7 @@ _SECTIONS = {
                  "states": bool},
     "sweep": None,  # names checked against the other sections
     "search": {"tau": dict, "q": float, "search_members": int, "steps": int,
-               "t_end": float},  # fmt: skip
+               "t_end": float, "confidence": float},  # fmt: skip
     "output": {"path": str},
 }
 _REQUIRED = {"model": ("file",), "law": ("kind",), "run": ("t_end", "tau")}
@@ -144,8 +144,12 @@ class Study:
         if self.search is not None:
             s = self.search
             head += (f"; searched: tau in [{s['tau'][0]:g}, {s['tau'][1]:g}] to rtol "
-                     f"{s['rtol']:g} (probes of {s['search_members']} members, confirmed "
-                     f"with {self.ensemble['members']})")  # fmt: skip
+                     f"{s['rtol']:g} " + (
+                         f"(probes of {s['search_members']} members, confirmed with "
+                         f"{self.ensemble['members']})" if s.get("confidence") is None else
+                         f"(each probe decided at its share of confidence "
+                         f"{s['confidence']:g}, {s['search_members']} … "
+                         f"{self.ensemble['members']} members)"))  # fmt: skip
         return "\n".join([head, *self.notes])
 
 
@@ -406,7 +410,7 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
 
 def _search(raw: dict, fail) -> dict:
     """``[search] tau = { bisect = [low, high], rtol = 1e-3 }`` with ``q``,
-    ``search_members`` and ``steps`` or ``t_end``, checked."""
+    ``search_members``, ``steps`` or ``t_end``, and ``confidence``, checked."""
     spec = raw.get("tau")
     if spec is None:
         fail("[search] tau", "missing: give tau = { bisect = [low, high], rtol = 1e-3 }")
@@ -435,8 +439,15 @@ def _search(raw: dict, fail) -> dict:
         fail("[search] steps", f"must be at least 1, got {raw['steps']}")
     if "t_end" in raw and not (math.isfinite(raw["t_end"]) and raw["t_end"] > 0):
         fail("[search] t_end", f"must be positive and finite, got {raw['t_end']}")
+    confidence = raw.get("confidence")
+    if confidence is not None:
+        if not 0.0 < confidence < 1.0:
+            fail("[search] confidence", f"must lie between 0 and 1, got {confidence:g}")
+        if not q > 0.0:
+            fail("[search] confidence", "needs q above 0 (no number of members shows a "
+                 "fraction to be 0): give q, e.g. q = 0.05")  # fmt: skip
     return {"tau": (lo, hi), "rtol": rtol, "q": float(q), "search_members": n,
-            "steps": raw.get("steps"), "t_end": raw.get("t_end")}
+            "steps": raw.get("steps"), "t_end": raw.get("t_end"), "confidence": confidence}
 
 
 def _typed(val, kind, key, fail):
