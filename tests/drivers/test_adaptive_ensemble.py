@@ -132,7 +132,8 @@ def test_adaptive_samples_change_no_step():
     0.001 every member takes the same steps and every measure has the same bits.  The
     stored samples are the residual of the dense output between the steps: within 0.5 % of the
     residual of states integrated to the sample times (``integrate_adaptive``, whose steps
-    end there) wherever it lies far above the floor."""
+    end there) wherever it lies far above the floor, or within the two runs' own
+    integration errors (the smallest member, ‖α⁰‖ = 1e-4, differs by 1.2e-6 at 1.1e-4)."""
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)
     radius = (1e-4, 1e-2)
@@ -156,7 +157,11 @@ def test_adaptive_samples_change_no_step():
         ref, got = one.residual_norm.values, ds.residual_norm.values[j]
         far = ref > 1e3 * float(ds.residual_floor[j])
         assert far.sum() >= 100, far.sum()
-        np.testing.assert_allclose(got[far], ref[far], rtol=5e-3)
+        # beside the interpolation: the two runs' own errors (different steps), each up to
+        # rtol per accepted step on states of size 1, seen in g through ‖∂g/∂x‖ ≤ 2|x| ≈ 2
+        # (the unit pendulum's ḟ = 2 q·v)
+        own = 4.0 * 1e-8 * int(ds.steps_accepted[j])
+        np.testing.assert_allclose(got[far], ref[far], rtol=5e-3, atol=own)
 
 
 @pytest.mark.parametrize("pair, xi, rtol, share", [("dopri5", 0.5, 1e-8, 0.99),
