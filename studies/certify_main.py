@@ -1,8 +1,8 @@
 """The README's main study run until decided, against 4096 members at every grid point.
 
 ``studies/pendulum_tau_omega.toml`` (the planar pendulum under Baumgarte's law, midpoint
-rule, 10 × 10 (τ, ω)) with ``[ensemble] members = { max = 1024, batch = 64 }`` (the
-default confidence 0.95 and q = 0.05), beside the same study with 4096 members at every
+rule, 10 × 10 (τ, ω); ``[ensemble] members = { max = 1024, batch = 64 }``, the default
+confidence 0.95 and q = 0.05), beside the same study with 4096 members at every
 grid point.  Where the 4096-member run's exact 95 % interval of the unstable fraction
 (Clopper–Pearson; its low end from the unstable members, its high end from those not
 stable) lies on one side of q, the sequential decision must be the same.  Also: the same
@@ -40,7 +40,7 @@ WORDS = {int(v): v.message for v in Verdict}
 
 def sequential_file(folder: Path, batch: int) -> Path:
     text = STUDY.read_text()
-    text = re.sub(r"(?m)^members = \d+$", f"members = {{ max = 1024, batch = {batch} }}", text)
+    text = re.sub(r"(?m)^members = .*$", f"members = {{ max = 1024, batch = {batch} }}", text)
     path = folder / f"sequential_{batch}.toml"
     path.write_text(text)
     return path
