@@ -18,7 +18,7 @@ from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, acpr, baumgarte, matrix, none, theorem5, user
 from ._loading import load_model, scene_names
 from ._model import Model, ModelError
-from ._profile import radial_profile
+from ._profile import paired_difference, radial_profile
 from ._schemes import (
     Scheme,
     SchemeError,
@@ -61,6 +61,7 @@ __all__ = [
     "matrix",
     "midpoint",
     "none",
+    "paired_difference",
     "radial_profile",
     "rk3",
     "rk4",

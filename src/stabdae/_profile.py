@@ -29,7 +29,7 @@ from ._codes import ProfileReason, Status, Verdict
 from ._schema import cf_dataset, schema_variable, variable
 from ._sequential import bounds
 
-__all__ = ["radial_profile"]
+__all__ = ["paired_difference", "radial_profile"]
 
 
 def radial_profile(ds: xr.Dataset, bins: int = 10, *, q: float = 0.05,
@@ -171,3 +171,55 @@ def _bracket(edges, low, high, level) -> tuple[float, float, int]:
     else:
         why = ProfileReason.OPEN_ABOVE
     return d_low, d_high, int(why)
+
+
+def paired_difference(a: xr.Dataset, b: xr.Dataset, *, confidence: float = 0.95) -> dict:
+    """The difference of the unstable fractions of two grid points, paired member by member.
+
+    The grid points of a study (and ensembles with the same seed and radius) run the same
+    members: member ``i`` starts from the same ``α⁰`` target at both.  Their difference is
+    then read on the members whose verdicts differ: ``b_ab`` unstable at ``a`` and not at
+    ``b``, ``b_ba`` the reverse, of the ``n`` members both ran and judged.  The interval is
+    conditional on the discordant members: given ``d = b_ab + b_ba`` of them, ``b_ab`` is
+    binomial with ``π = p_ab / (p_ab + p_ba)``; a Clopper–Pearson interval for ``π`` at
+    ``confidence`` maps to ``p_a − p_b = (d/n)(2π − 1)`` with the share ``d/n`` taken as
+    observed (exact given ``d``; its sign is McNemar's exact test: the interval excludes 0
+    where the test rejects equal fractions).  Where no member differs, the difference is
+    at most the share of members that would: ``±`` its exact upper bound at
+    ``confidence``.
+
+    Returns ``{"members", "a_only", "b_only", "difference", "low", "high"}`` (fractions of
+    ``members``); undecided members and members either point did not run are left out."""
+    who = "paired_difference"
+    for name, ds in (("a", a), ("b", b)):
+        if "verdict" not in ds.variables or ds["verdict"].dims != ("member",):
+            got = "no verdict" if "verdict" not in ds.variables else ds["verdict"].dims
+            raise ValueError(f"{who}: {name} must be one ensemble (verdict over member), "
+                             f"got {got}")  # fmt: skip
+    for key in ("seed", "radius_low", "radius_high"):
+        if key in a.attrs and key in b.attrs and a.attrs[key] != b.attrs[key]:
+            raise ValueError(f"{who}: the two ran different members ({key} {a.attrs[key]} "
+                             f"against {b.attrs[key]}): pairing needs the same seed and radius")
+    if isinstance(confidence, bool) or not 0.0 < float(confidence) < 1.0:
+        raise ValueError(f"{who}: confidence must be between 0 and 1, got {confidence!r}")
+    k = min(a.sizes["member"], b.sizes["member"])
+    va, vb = a["verdict"].values[:k], b["verdict"].values[:k]
+    judged = (va != int(Verdict.UNDECIDED)) & (vb != int(Verdict.UNDECIDED))
+    for ds in (a, b):
+        if "status" in ds:
+            judged &= ds["status"].values[:k] != int(Status.NOT_NEEDED)
+    ua, ub = va[judged] == int(Verdict.UNSTABLE), vb[judged] == int(Verdict.UNSTABLE)
+    n = int(judged.sum())
+    ab, ba = int((ua & ~ub).sum()), int((~ua & ub).sum())
+    d = ab + ba
+    if n == 0:
+        return {"members": 0, "a_only": 0, "b_only": 0, "difference": math.nan,
+                "low": math.nan, "high": math.nan}  # fmt: skip
+    if d == 0:  # no member tells them apart: |p_a − p_b| is at most the discordant share
+        most = bounds(0, n, 1.0 - float(confidence))[1]
+        return {"members": n, "a_only": 0, "b_only": 0, "difference": 0.0, "low": -most,
+                "high": most}  # fmt: skip
+    lo, hi = bounds(ab, d, (1.0 - float(confidence)) / 2.0)
+    share = d / n
+    return {"members": n, "a_only": ab, "b_only": ba, "difference": (ab - ba) / n,
+            "low": share * (2.0 * lo - 1.0), "high": share * (2.0 * hi - 1.0)}

@@ -91,3 +91,34 @@ def test_on_a_pendulum_the_bracket_holds_the_samples_own_delta_star(tmp_path):
     assert int(p.delta_star_reason) == int(ProfileReason.BRACKETED)
     assert float(p.delta_star_low) <= float(ds.stability_radius) <= float(p.delta_star_high)
     assert profile_curve(p, tmp_path / "p.png").stat().st_size > 10_000
+
+
+# --------------------------------------------------------------------- paired differences
+def verdicts(codes) -> xr.Dataset:
+    return xr.Dataset({"verdict": ("member", np.asarray(codes, dtype=np.int8))},
+                      attrs={"seed": 1, "radius_low": 1e-4, "radius_high": 1.0})  # fmt: skip
+
+
+def test_a_paired_difference_reads_the_discordant_members():
+    """From the definition: 30 members unstable at a only, 5 at b only, of 200 judged (10
+    undecided left out): the difference 25/200, and its interval the Clopper–Pearson one
+    of π = 30/35 mapped by (d/n)(2π − 1)."""
+    from scipy import stats
+
+    S, U, X = int(Verdict.STABLE), int(Verdict.UNSTABLE), int(Verdict.UNDECIDED)
+    a = [U] * 30 + [S] * 5 + [U] * 40 + [S] * 125 + [X] * 10
+    b = [S] * 30 + [U] * 5 + [U] * 40 + [S] * 125 + [S] * 10
+    out = stabdae.paired_difference(verdicts(a), verdicts(b))
+    assert (out["members"], out["a_only"], out["b_only"]) == (200, 30, 5)
+    assert out["difference"] == pytest.approx(25 / 200)
+    ci = stats.binomtest(30, 35).proportion_ci(0.95, method="exact")
+    assert out["low"] == pytest.approx(35 / 200 * (2 * ci.low - 1), rel=1e-9)
+    assert out["high"] == pytest.approx(35 / 200 * (2 * ci.high - 1), rel=1e-9)
+    assert 0 < out["low"] < out["difference"] < out["high"]
+    same = stabdae.paired_difference(verdicts(a), verdicts(a))  # none differs: at most
+    assert same["difference"] == 0.0  # the discordant share, 1 − 0.05^{1/200}
+    assert same["high"] == -same["low"] == pytest.approx(1 - 0.05 ** (1 / 200), rel=1e-9)
+    other = verdicts(b)
+    other.attrs["seed"] = 2
+    with pytest.raises(ValueError, match="paired_difference: the two ran different members"):
+        stabdae.paired_difference(verdicts(a), other)
