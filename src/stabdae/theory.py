@@ -340,20 +340,9 @@ def _spectral_limit(A, scheme, tau_max: float) -> float:
 def lyapunov_weight(R):
     """``P = X^{1/2}`` with ``RᵀXR − X = −I``, or ``None`` when no SPD ``X`` exists
     (``ρ(R) ≥ 1``)."""
-    n = R.shape[0]
     if not np.all(np.isfinite(R)) or spectral_radius(R) >= 1.0:
         return None
-    try:
-        with warnings.catch_warnings():  # ρ → 1 makes X large and ill-conditioned
-            warnings.simplefilter("ignore", sla.LinAlgWarning)
-            X = sla.solve_discrete_lyapunov(R.T, np.eye(n))
-    except (np.linalg.LinAlgError, ValueError):
-        return None
-    X = 0.5 * (X + X.T)
-    w, V = np.linalg.eigh(X)
-    if not (np.all(np.isfinite(w)) and w.min() > 0):
-        return None
-    return (V * np.sqrt(w)) @ V.T
+    return _weight(R, np.eye(R.shape[0]))
 
 
 def weighted_norm(R, P=None) -> float:
