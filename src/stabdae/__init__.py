@@ -14,6 +14,7 @@ from ._adaptive import integrate_adaptive
 from ._boundary import boundary
 from ._codes import Status
 from ._ensemble import ensemble, sample_perturbations
+from ._gains import balanced_gain, gain_floor
 from ._integrate import IntegrationWarning, integrate
 from ._laws import Law, LawError, acpr, baumgarte, matrix, none, theorem5, user
 from ._loading import load_model, scene_names
@@ -47,12 +48,14 @@ __all__ = [
     "Status",
     "__version__",
     "acpr",
+    "balanced_gain",
     "baumgarte",
     "boundary",
     "dop853",
     "dopri5",
     "ensemble",
     "euler",
+    "gain_floor",
     "heun",
     "heun3",
     "integrate",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -149,6 +150,8 @@ def _cmd_theory(args) -> int:
           f"(rho {rec['rho_holonomic']:.2g}, {how(rec['steps_holonomic'])}); first-order "
           f"k = {rec['k']:.6g} (rho {rec['rho_first_order']:.3g}, "
           f"{how(rec['steps_first_order'])})")  # fmt: skip
+    if args.level is not None:
+        _print_floors(study, base, rec, args.level)
     print("\nper grid point (R = R(τÃ); cond: the weighted-norm condition of Theorems 6/7):")
     print(format_table(ds))
     print("\ncolumns: rho(R) spectral radius of R(τÃ); |R|max its max-norm (the paper's); "
@@ -156,6 +159,45 @@ def _cmd_theory(args) -> int:
           "6/7); beta −max Re λ(Ã); beta_disc\n−ln rho(R)/τ; Lyap whether Theorem 4's "
           "Lyapunov function exists; tau_lim the largest τ with\nrho(R) < 1")
     return 0
+
+
+def _print_floors(study, base, rec, level: float) -> None:
+    """The floors of the minimal-rho gain and of the study's law, and the balanced gain
+    for ``level`` (:mod:`stabdae._gains`), at the study's first grid point."""
+    from .._gains import balanced_gain, gain_floor
+    from .._laws import baumgarte
+
+    if not level > 0:
+        raise ValueError(f"stabdae theory: --level must be positive, got {level:g}")
+    model, scheme, tau = study.model, base["scheme"], base["tau"]
+    t_end, p = base["t_end"], base["params"]
+    start = float(study.ensemble["radius"][1])
+    dead = gain_floor(model, baumgarte(rec["omega"], rec["xi"]), scheme, tau, t_end, params=p)
+    print(f"\nfloors at tau = {tau:g} ({scheme.name}; the residual each gain settles on: "
+          "predicted from the scheme's one-step remainders through (I - R)^-1, measured by "
+          "16 members):")  # fmt: skip
+    print(f"  minimal-rho gain omega = {rec['omega']:.6g}: predicted {dead['predicted']:.3g}, "
+          f"measured {dead['measured']:.3g}")  # fmt: skip
+    law = base["law"]
+    if law.is_constant:
+        own = gain_floor(model, law, scheme, tau, t_end, params=p)
+        gains = ", ".join(f"{k} = {v:g}" for k, v in study.law.items()
+                          if k in ("omega", "xi", "k"))  # fmt: skip
+        print(f"  the study's law ({gains or study.law['kind']}): predicted "
+              f"{own['predicted']:.3g}, measured {own['measured']:.3g}")  # fmt: skip
+    b = balanced_gain(model, scheme, tau, level, start, t_end=t_end, params=p)
+    if math.isfinite(b["omega"]):
+        print(f"  balanced gain for the level {level:g} from {start:g}: omega = {b['omega']:.4g} "
+              f"(xi = 1), below it after {b['time']:.3g} s (predicted); the minimal-rho gain "
+              + (f"after {b['deadbeat_time']:.3g} s" if math.isfinite(b["deadbeat_time"])
+                 else "never: its floor is above the level")
+              + ". A stiffer gain contracts faster but its steps leave more residual behind: "
+              "the balanced gain is the one whose floor is just low enough")  # fmt: skip
+    else:
+        print(f"  no Baumgarte gain from {b['omegas'][0]:.4g} down to {b['omegas'][-1]:.4g} "
+              f"brings the residual below {level:g} within the run (smallest predicted floor "
+              f"{np.nanmin(b['floors']):.3g}): a smaller step or a higher-order scheme "
+              "lowers the floor")  # fmt: skip
 
 
 def _cmd_run(args) -> int:
@@ -267,6 +309,11 @@ def main(argv: list[str] | None = None) -> int:
     thy.add_argument("study", help="study file (TOML)")
     thy.add_argument("--trust-model", action="store_true",
                      help="run a model file the study names outside its own folder")
+    thy.add_argument("--level", type=float, metavar="L",
+                     help="also weigh the gains' floors: the Baumgarte gain that brings the "
+                     "residual below L soonest (from the study's largest perturbation), "
+                     "beside the minimal-rho gain and the study's own, each with its floor "
+                     "(predicted and measured; integrates the model)")
     thy.set_defaults(func=_cmd_theory)
 
     run = sub.add_parser("run", help="run a study: ensembles over its grid, dataset and "
