@@ -404,8 +404,13 @@ def boundary_curve(ds: xr.Dataset, path: Path) -> Path:
         star = sub["tau_star"].values
         lo, hi = sub["tau_star_low"].values, sub["tau_star_high"].values
         ok = np.isfinite(star)
+        conf = sub["tau_star_confidence"].values if "tau_star_confidence" in sub else None
+        what = "measured τ* (bracket)"
+        if conf is not None and np.isfinite(conf).any():  # probes decided at a confidence
+            what = f"measured τ* (bracket: the boundary inside at {np.nanmin(conf):g})"
+            ax.fill_between(x[ok], lo[ok], hi[ok], color="tab:blue", alpha=0.2, lw=0)
         ax.errorbar(x[ok], star[ok], yerr=[star[ok] - lo[ok], hi[ok] - star[ok]], fmt="o",
-                    color="tab:blue", ms=5, capsize=3, label="measured τ* (bracket)")
+                    color="tab:blue", ms=5, capsize=3, label=what)
         for xi, l_, h_ in zip(x[~ok], lo[~ok], hi[~ok]):  # no bracket: the end that held
             y = l_ if np.isfinite(l_) else h_
             ax.plot([xi], [y], marker="^" if np.isfinite(l_) else "v", color="tab:red")

@@ -72,6 +72,11 @@ def summary(ds: xr.Dataset) -> str:
         head = ("boundary (tau*: largest stable step, between low (stable with the full "
                 "ensemble) and high; tau_floor: Theorems 6/7 with the floor the local error "
                 "forces; tau_spectral: rho(R) = 1):")  # fmt: skip
+        if "tau_star_confidence" in ds and np.isfinite(ds.tau_star_confidence.values).any():
+            conf = float(np.nanmin(ds.tau_star_confidence.values))
+            head = head[:-2] + (f"; every probe decided at its share of confidence {conf:g}: "
+                                "the boundary lies between low and high with at least that "
+                                "probability):")  # fmt: skip
         return "\n" + head + "\n" + grid_table(ds, cols, short, precise=cols[:5]) + "\n"
     cols = [c for c in ("decision", "members_used",
                         "fraction_stable", "fraction_unstable", "fraction_undecided",
