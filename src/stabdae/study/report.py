@@ -74,7 +74,7 @@ def summary(ds: xr.Dataset) -> str:
                 "forces; tau_spectral: rho(R) = 1):")  # fmt: skip
         if "tau_star_confidence" in ds and np.isfinite(ds.tau_star_confidence.values).any():
             conf = float(np.nanmin(ds.tau_star_confidence.values))
-            head = head[:-2] + (f"; every probe decided at its share of confidence {conf:g}: "
+            head = head[:-2] + (f"; the probes decided at confidence {conf:g} all together: "
                                 "the boundary lies between low and high with at least that "
                                 "probability):")  # fmt: skip
         return "\n" + head + "\n" + grid_table(ds, cols, short, precise=cols[:5]) + "\n"
