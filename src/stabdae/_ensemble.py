@@ -22,7 +22,7 @@ import xarray as xr
 
 from . import _measures, theory
 from . import _validate as check
-from ._codes import DecisionReason, Status
+from ._codes import DecisionReason, Status, messages
 from ._ensemble_dataset import Table, _warn_stopped
 from ._ensemble_dataset import ensemble_table as _table
 from ._model import Model
@@ -892,7 +892,7 @@ def measure_stride(R) -> int:
 
 #: members whose final states set the roundoff level the growth test compares with
 ROUNDOFF_SAMPLE = 16
-DECISION_REASONS = {int(c): c.message for c in DecisionReason}
+DECISION_REASONS = messages(DecisionReason)
 
 
 def _roundoff(model, x_final, status, p, t, gain, threads, sampled=False):

@@ -143,9 +143,10 @@ def balanced_gain(model, scheme, tau: float, level: float, start: float, *, xi: 
                               level, steps) * tau)  # fmt: skip
     times = np.asarray(times)
     best = int(np.argmin(times)) if np.isfinite(times).any() else None
-    dead = gain_floor(model, baumgarte(rec["omega"], rec["xi"]), scheme, tau, t_end,
-                      params=params, members=0)["predicted"]  # fmt: skip
-    dead_R = theory.step_matrix(baumgarte(rec["omega"], rec["xi"]).A_tilde(model), scheme, tau)
+    dead_law = baumgarte(rec["omega"], rec["xi"])
+    dead = gain_floor(model, dead_law, scheme, tau, t_end, params=params,
+                      members=0)["predicted"]  # fmt: skip
+    dead_R = theory.step_matrix(dead_law.A_tilde(model), scheme, tau)
     return {"omega": math.nan if best is None else float(omegas[best]),
             "time": math.inf if best is None else float(times[best]),
             "omegas": omegas, "floors": np.asarray(floors), "times": times,

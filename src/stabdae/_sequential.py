@@ -30,7 +30,6 @@ not depend on the batches it was run in, only on how many members it ran.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from scipy import special
@@ -148,14 +147,13 @@ def decide(plan: Sequential, n: int, unstable: int, not_stable: int, last: bool)
     """The decision after ``n`` members, ``unstable`` of them unstable and ``not_stable``
     unstable or undecided (``last``: no look follows)."""
     a = plan.side_level
-    low = bounds(unstable, n, a)[0]
-    high = bounds(not_stable, n, a)[1]
+    (low, unstable_high), (not_stable_low, high) = bounds(unstable, n, a), bounds(not_stable, n, a)
     if high <= plan.q:
         return Decision(int(Verdict.STABLE), int(DecisionReason.STABLE), low, high)
     if low > plan.q:
         return Decision(int(Verdict.UNSTABLE), int(DecisionReason.UNSTABLE), low, high)
     undecided = int(Verdict.UNDECIDED)
-    if bounds(not_stable, n, a)[0] > plan.q and bounds(unstable, n, a)[1] <= plan.q:
+    if not_stable_low > plan.q and unstable_high <= plan.q:
         return Decision(undecided, int(DecisionReason.MEMBERS_UNDECIDED), low, high)
     if plan.tolerance is not None and high - low <= plan.tolerance:
         return Decision(undecided, int(DecisionReason.WITHIN_TOLERANCE), low, high)
@@ -163,9 +161,3 @@ def decide(plan: Sequential, n: int, unstable: int, not_stable: int, last: bool)
         return Decision(undecided, int(DecisionReason.MAX_REACHED), low, high)
     return Decision(None, int(DecisionReason.MAX_REACHED), low, high)
 
-
-def members_needed(plan: Sequential) -> int:
-    """The fewest members that can decide *stable* (every one of them stable): the first
-    look with ``1 − level^{1/n} ≤ q``."""
-    need = math.log(plan.side_level) / math.log1p(-plan.q)
-    return next((n for n in plan.looks() if n >= need), plan.max)
