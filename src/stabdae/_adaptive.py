@@ -127,10 +127,16 @@ def integrate_adaptive(
         )  # fmt: skip
     status = Status(status)
     if status != Status.OK:
+        hint = ""
+        if status == Status.STEP_TOO_SMALL and multiplier == "ldl" and model.m + model.k > 1:
+            # near a configuration where the constraints lose rank, S is ill-conditioned
+            # and the error estimate never settles; the pseudo-inverse passes such points
+            hint = ("; if the constraints lose rank there (a singular position of the "
+                    "mechanism), multiplier='lstsq' integrates through it")
         warnings.warn(
             f"integrate_adaptive({model.name}): stopped after {int(counts[0])} accepted steps "
-            f"({written - 1} of {nsave - 1} samples): {status.description}; samples up to "
-            "there are kept, later ones are NaN",
+            f"({written - 1} of {nsave - 1} samples): {status.description}{hint}; samples up "
+            "to there are kept, later ones are NaN",
             IntegrationWarning,
             stacklevel=2,
         )

@@ -493,6 +493,38 @@ def test_summary_names_unstable_members_where_the_law_is_stable():
     assert "linear part is stable" not in summary(calm)
 
 
+def test_summary_says_which_blown_up_members_met_a_singular_constraint_matrix():
+    """Members that blew up are counted by how they stopped; where some stopped at a
+    singular S (the constraints lost rank: the theorems assume they do not), the note
+    says so instead of blaming only the scheme's remainder."""
+    from stabdae._codes import Status, Verdict, VerdictReason
+    from stabdae.study.report import summary
+
+    S, U = int(Verdict.STABLE), int(Verdict.UNSTABLE)
+    B = int(VerdictReason.BLEW_UP)
+    verdict = np.array([[U, U, U, S], [U, S, S, S]], dtype=np.int8)
+    reason = np.array([[B, B, B, 0], [B, 0, 0, 0]], dtype=np.int8)
+    status = np.array([[int(Status.SINGULAR_S), int(Status.SINGULAR_S),
+                        int(Status.NONFINITE_STATE), 0], [int(Status.DIVERGED), 0, 0, 0]],
+                      dtype=np.int8)  # fmt: skip
+    ds = xr.Dataset({"verdict": (("run.tau", "member"), verdict),
+                     "verdict_reason": (("run.tau", "member"), reason),
+                     "status": (("run.tau", "member"), status),
+                     "spectral_radius": ("run.tau", [0.5, 0.8]),
+                     "fraction_stable": ("run.tau", (verdict == S).mean(axis=1)),
+                     "fraction_unstable": ("run.tau", (verdict == U).mean(axis=1))},
+                    coords={"run.tau": [0.01, 0.02]})  # fmt: skip
+    text = summary(ds)
+    head, *notes = text.split("unstable where the law's linear part is stable")[1].splitlines()
+    assert [n for n in notes if n.strip()] == [
+        "  tau = 0.01: rho(R) = 0.5 < 1, yet 3 of 4 members unstable (3 blew up: 2 singular S, "
+        "1 non-finite state)",
+        "  tau = 0.02: rho(R) = 0.8 < 1, yet 1 of 4 members unstable (1 blew up: 1 diverged)"]
+    assert "singular S" in head and "rank" in head
+    calm = ds.isel({"run.tau": [1]})
+    assert "rank" not in summary(calm)
+
+
 def test_a_search_studys_progress_moves_with_its_probes(tmp_path):
     """A boundary search's grid point is counted in the members of the probes it is
     expected to run (the bracket's ends, two beside the spectral limit, the bisection to

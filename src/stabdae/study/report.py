@@ -116,7 +116,7 @@ def unstable_below_one(ds: xr.Dataset) -> str:
     flat = ds[["spectral_radius", "verdict", "verdict_reason"]
               + (["status"] if "status" in ds else [])]
     flat = flat.stack(point=dims) if dims else flat.expand_dims(point=[0])
-    lines = []
+    lines, singular = [], False
     for i in range(flat.sizes["point"]):
         rho = float(flat.spectral_radius.values[i])
         verdict = flat.verdict.isel(point=i).values
@@ -127,15 +127,29 @@ def unstable_below_one(ds: xr.Dataset) -> str:
                           for d in dims)  # fmt: skip
         reasons, counts = np.unique(flat.verdict_reason.isel(point=i).values[unstable],
                                     return_counts=True)  # fmt: skip
-        why = "; ".join(f"{c} {VerdictReason(int(r)).message.split(':')[0]}"
-                        for r, c in zip(reasons, counts))  # fmt: skip
+        why = [f"{c} {VerdictReason(int(r)).message.split(':')[0]}"
+               for r, c in zip(reasons, counts)]  # fmt: skip
         ran = verdict.size
         if "status" in flat:  # (a grid point run until decided: its own members only)
-            ran = int((flat.status.isel(point=i).values != int(Status.NOT_NEEDED)).sum())
+            status = flat.status.isel(point=i).values
+            ran = int((status != int(Status.NOT_NEEDED)).sum())
+            blew = status[unstable & (flat.verdict_reason.isel(point=i).values
+                                      == int(VerdictReason.BLEW_UP))]  # fmt: skip
+            if blew.size:  # how they stopped: a singular S is not the scheme's remainder
+                how, many = np.unique(blew, return_counts=True)
+                singular = singular or int(Status.SINGULAR_S) in how
+                k = [int(r) for r in reasons].index(int(VerdictReason.BLEW_UP))
+                why[k] += ": " + ", ".join(f"{c} {Status(int(s)).short}"
+                                           for s, c in zip(how, many))  # fmt: skip
+        why = "; ".join(why)
         lines.append(f"  {where}: rho(R) = {rho:.4g} < 1, yet {int(unstable.sum())} of "
                      f"{ran} members unstable ({why})")
     if not lines:
         return ""
-    return ("\nunstable where the law's linear part is stable (rho(R) < 1: what grows there "
-            "is the rest of the step, the scheme's remainder on the motion that Theorems 6/7 "
-            "bound, not the law):\n" + "\n".join(lines) + "\n")
+    cause = ("what grows there is the rest of the step, the scheme's remainder on the motion "
+             "that Theorems 6/7 bound, not the law")
+    if singular:
+        cause += ("; members that stopped at a singular S met a configuration where the "
+                  "constraints lose rank, which the theorems exclude")
+    return (f"\nunstable where the law's linear part is stable (rho(R) < 1: {cause}):\n"
+            + "\n".join(lines) + "\n")
