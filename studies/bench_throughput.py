@@ -86,21 +86,37 @@ def run_c(fn, x0):
     return time.perf_counter() - start, xf
 
 
-def run_kernel(model, law, x0, divergence, nsteps):
+def run_kernel(model, law, x0, divergence, nsteps, measure=True):
     """stabdae's ensemble kernel alone, with the inputs and outputs ``stabdae.ensemble``
     gives it (the reference trajectory's residuals, the linear prediction's ``R``; every
-    member traced, as the C stores every member's norms)."""
+    member traced, as the C stores every member's norms).  ``measure=False``: the decay
+    measured at the first state only (a stride longer than the run), so that the time is
+    the step's and the stored norms', as the C's."""
+    import dataclasses
+
     from stabdae import _ensemble as E
 
     run = E._run_spec("bench", model, law, "midpoint", TAU, model.t0 + nsteps * TAU, None,
                       None, x0.shape[0], (1e-6, 1e-2), 0, TAU * SAVE_EVERY, x0, None, None,
                       divergence, None, None, None, "float32", "all", True)  # fmt: skip
+    if not measure:
+        run = dataclasses.replace(run, mode=dataclasses.replace(run.mode, stride=nsteps + 1))
     alpha0 = E._residual_rows(model, x0, run.p, run.t0)
     g_ref = run.mode.reference(run)
     status = np.zeros(x0.shape[0], dtype=np.int8)
     start = time.perf_counter()
     out = run.mode.integrate(run, x0, alpha0, status, g_ref)
     return time.perf_counter() - start, out.x_final
+
+
+def member_ends(model, law, x0, divergence, repeat, short=SAVE_EVERY):
+    """Core time per member of what the kernel does once per member (placing it in a
+    slot, its decay fit, the map's radius, γ, its outputs), in µs: the intercept at zero
+    steps of the kernel's time over ``short`` and ``2 short`` steps (best of ``repeat``
+    each), times the threads."""
+    t1 = min(run_kernel(model, law, x0, divergence, short)[0] for _ in range(repeat))
+    t2 = min(run_kernel(model, law, x0, divergence, 2 * short)[0] for _ in range(repeat))
+    return (2.0 * t1 - t2) * numba.get_num_threads() / x0.shape[0] * 1e6
 
 
 def run_numpy(x0):
@@ -234,7 +250,7 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
         NSTEPS = round(T_END / TAU)
         x0, _, _ = stabdae.sample_perturbations(model, M, (1e-6, 1e-2), seed=1)
         steps = M * NSTEPS
-        api = api_all = kernel = t_blocked = t_ieee = t_base = np.inf
+        api = api_all = kernel = step_only = t_blocked = t_ieee = t_base = np.inf
         for _ in range(max(1, args.repeat)):  # in turn, best of each
             start = time.perf_counter()
             ds = stabdae.ensemble(model, law, "midpoint", TAU, T_END, x0=x0, save_dt=SAVE_DT)
@@ -245,6 +261,9 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
             api_all = min(api_all, time.perf_counter() - start)
             t, xf_kernel = run_kernel(model, law, x0, ds.attrs["divergence"], NSTEPS)
             kernel = min(kernel, t)
+            t, xf_step = run_kernel(model, law, x0, ds.attrs["divergence"], NSTEPS,
+                                    measure=False)  # fmt: skip
+            step_only = min(step_only, t)
             if baseline:
                 t, xf_base = baseline.run(x0, T_END)
                 t_base = min(t_base, t)
@@ -252,11 +271,15 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
             t_blocked = min(t_blocked, t)
             t_ieee = min(t_ieee, run_c(lib_ieee.run_blocked, x0)[0])
         assert np.array_equal(xf_kernel, ds.x_final.values)
+        assert np.array_equal(xf_step, xf_kernel)  # the measurement changes no state
+        ends = member_ends(model, law, x0, ds.attrs["divergence"], max(1, args.repeat))
         t_scalar, xf_scalar = run_c(lib.run_scalar, x0)
         xs = ds.x_final.values
         row = {"members": M, "t_end": T_END, "member_steps": steps,
                "repeat": max(1, args.repeat), "stabdae_api_s": api,
                "stabdae_api_all_traces_s": api_all, "stabdae_kernel_s": kernel,
+               "stabdae_kernel_step_only_s": step_only,
+               "member_ends_core_us": ends,
                "c_scalar_s": t_scalar, "c_blocked_s": t_blocked,
                "c_blocked_no_fma_s": t_ieee,
                "max_diff_vs_c": float(np.max(np.abs(xs - xf_blocked)))}  # fmt: skip
@@ -275,7 +298,8 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
         print(f"{'variant':<34} {'seconds':>9} {'member-steps/s':>15} {'÷ vectorized C':>15}")
         variants = [("stabdae ensemble (public API)", api),
                     ("  the same, every member traced", api_all),
-                    ("stabdae kernel only", kernel)]  # fmt: skip
+                    ("stabdae kernel only", kernel),
+                    ("  the same, measurement off", step_only)]  # fmt: skip
         if baseline:
             variants.append((f"stabdae API at {baseline.rev[:10]}", t_base))
         variants += [("C, one member per iteration", t_scalar),
@@ -287,6 +311,8 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
             variants.append(("JAX scan + vmap", row["jax_s"]))
         for name, secs in variants:
             print(f"{name:<34} {secs:9.3f} {steps / secs:15.3g} {t_blocked / secs:15.3f}")
+        print(f"each member's start and end in the kernel: {ends:.3f} µs of core time "
+              f"({numba.get_num_threads()} threads)")
         if baseline:
             print(f"this revision's API over {baseline.rev[:10]}'s: {t_base / api:.3f} "
                   f"(same final states: {row['baseline_same_final_states']})")
