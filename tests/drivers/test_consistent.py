@@ -25,14 +25,16 @@ def test_pendulum_state_is_the_closed_form():
     ("double_pendulum", {"x1": 0.5, "x2": 0.9, "x1_dot": 0.2, "x2_dot": -0.1}),
     ("slider_crank", {"phi": 0.4, "phi_dot": 2.0}),
     ("n_four_bar", {"x0": 0.6, "x0_dot": -0.4}),  # one crank's tip: the rest follows
+    ("flyball_governor", {"psi": 0.3, "s": 0.55, "x1": 0.8, "x2": -0.7, "psi_dot": 5.0,
+                          "s_dot": 0.1, "z1_dot": 0.2, "z2_dot": -0.1}),
     ("knife_edge", {"x": 0.1, "y": 0.2, "phi": 0.7, "x_dot": 1.0, "phi_dot": 0.3}),
     ("rolling_disk", {"x": 0.1, "y": 0.2, "phi": 0.3, "theta": 0.2, "psi": 0.1,
                       "phi_dot": 1.0, "theta_dot": 0.2, "psi_dot": 3.0}),
 ])  # fmt: skip
 def test_consistent_states_of_scenes(name, fixed):
-    """Holonomic (double pendulum, slider-crank, the N-four-bar), nonholonomic (knife edge) and both
-    (rolling disk): the residual g = (f, ḟ, h) is at most 1e-13 and every held
-    component keeps its value exactly."""
+    """Holonomic (double pendulum, slider-crank, the N-four-bar, the flyball governor),
+    nonholonomic (knife edge) and both (rolling disk): the residual g = (f, ḟ, h) is at
+    most 1e-13 and every held component keeps its value exactly."""
     model = load_scene(name)
     x = model.consistent_state(fixed)
     assert np.max(np.abs(model.residual(x))) <= 1e-13
