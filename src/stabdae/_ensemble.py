@@ -144,11 +144,19 @@ def _place(model, targets, p, t0, threads=None, beside=None):
     return x0, alpha0, status, other
 
 
+#: up to this many rows, :func:`_residual_rows` runs on the calling thread (a roundoff
+#: level's 16 states × (4n + 1) rows take microseconds; a trip to the pool about a
+#: millisecond)
+SMALL_ROWS = 1024
+
+
 def _residual_rows(model, x, p, t0, threads=None, sampler=False):
     """``g(x_i, t0)`` for every row of ``x`` (compiled; NaN rows give NaN); by the
     model's sampler when ``sampler`` (an ensemble that sampled its members has it
     compiled: the same numbers, without compiling a kernel for them)."""
     out = np.empty((x.shape[0], model.n_residual))
+    if x.shape[0] <= SMALL_ROWS:  # a few rows: the trip to the threads costs more than they
+        threads = 1
     if sampler:
         kernel = sampler_for(model)
         x = np.ascontiguousarray(x, dtype=float)  # (only read: the sampler writes no state)
