@@ -50,6 +50,22 @@ def _label(ds, dim) -> str:
     return f"{names.get(dim, dim)}" + (f" [{units}]" if units not in ("", "1") else "")
 
 
+def _log_scale(ax, which: str, edges) -> None:
+    """A log scale on ``ax``'s ``which`` ("x" or "y") axis over cell ``edges``.  Where they
+    span a decade or more, the labels are 1 and 3 × 10^k (up to about two and a half
+    decades) or the powers of ten: matplotlib's own choice adds 2, 3, 4 and 6 × 10^k up to
+    about two decades, and on a map's width those run into each other."""
+    from matplotlib.ticker import LogLocator, NullFormatter
+
+    getattr(ax, f"set_{which}scale")("log")
+    span = edges.max() / edges.min()
+    axis = getattr(ax, f"{which}axis")
+    if span >= 10.0:
+        axis.set_minor_formatter(NullFormatter())
+    if 10.0 <= span < 10.0**2.5:
+        axis.set_major_locator(LogLocator(subs=(1.0, 3.0)))
+
+
 def _is_log(values) -> bool:
     v = np.asarray(values, dtype=float)
     return bool(len(v) >= 3 and np.all(v > 0) and v.max() / v.min() >= 20)
@@ -136,8 +152,9 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
         if handles:
             leg = ax.legend(*zip(*handles), loc="upper right", framealpha=0.9, fontsize=8.5)
             leg.set_title("theory: holds inside the outline", prop={"size": 8.5})
-        ax.set_xscale("log" if xlog else "linear")
-        ax.set_yscale("log" if ylog else "linear")
+        for which, log, edges in (("x", xlog, xe), ("y", ylog, ye)):
+            if log:
+                _log_scale(ax, which, edges)
         ax.set_xlabel(_label(ds, xd))
         ax.set_ylabel(_label(ds, yd))
         if note:
@@ -210,12 +227,14 @@ def decision_map(ds: xr.Dataset, path: Path) -> Path:
     conf = ds.attrs.get("sequential_confidence", "")
     q = ds.attrs.get("sequential_q", "")
     for ax, what in zip(axes, ("decision", "members used")):
-        ax.set_xscale("log" if xlog else "linear")
+        if xlog:
+            _log_scale(ax, "x", xe)
         ax.set_xlabel(_label(ds, xd))
         if yd == "_row":
             ax.set_yticks([])
         else:
-            ax.set_yscale("log" if ylog else "linear")
+            if ylog:
+                _log_scale(ax, "y", ye)
             ax.set_ylabel(_label(ds, yd))
         ax.set_title(f"{what}" + (f" (q = {q}, confidence {conf})" if what == "decision"
                                   else f", {int(used.sum())} in all"), fontsize=10)

@@ -1,0 +1,62 @@
+"""The stability pictures are legible: no two tick labels on an axis run into each other."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from stabdae import plots
+
+
+def drawn_figure(monkeypatch, draw, *args):
+    """Run ``draw(*args)`` and return the figure it saved (drawn, so labels have sizes)."""
+    import matplotlib.figure
+
+    saved = {}
+    real = matplotlib.figure.Figure.savefig
+
+    def keep(self, *a, **k):
+        saved["fig"] = self
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", keep)
+    draw(*args)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = saved["fig"]
+    FigureCanvasAgg(fig).draw()  # (a closed figure keeps no canvas of its own)
+    return fig
+
+
+def overlapping_labels(axis, renderer) -> int:
+    labels = [t for t in axis.get_ticklabels(minor=True) + axis.get_ticklabels()
+              if t.get_visible() and t.get_text()]  # fmt: skip
+    boxes = sorted((t.get_window_extent(renderer) for t in labels), key=lambda b: b.x0)
+    return sum(1 for a, b in zip(boxes, boxes[1:]) if a.x1 > b.x0)
+
+
+@pytest.mark.parametrize("draw", ["stability_map", "decision_map"])
+def test_tick_labels_of_a_log_axis_spanning_a_decade_and_a_half_do_not_overlap(
+        monkeypatch, tmp_path, draw):
+    """τ from 2e-3 to 5e-2 (a study's grid): matplotlib's own choice labels 2, 3, 4 and
+    6 × 10^k as well, and on a picture of this width they ran into each other (6 pairs
+    before)."""
+    tau = np.geomspace(2e-3, 5e-2, 6)
+    omega = np.geomspace(1.0, 1e3, 6)
+    shape = (tau.size, omega.size)
+    rng = np.random.default_rng(0)
+    ds = xr.Dataset(
+        {"fraction_stable": (("tau", "omega"), rng.uniform(size=shape)),
+         "fraction_bounded": (("tau", "omega"), rng.uniform(size=shape)),
+         "spectral_radius": (("tau", "omega"), np.outer(tau, omega) / 2.79),
+         "decision": (("tau", "omega"), rng.integers(0, 3, size=shape).astype(np.int8)),
+         "members_used": (("tau", "omega"), rng.choice([32, 64, 128], size=shape))},
+        coords={"tau": ("tau", tau, {"units": "s"}), "omega": ("omega", omega, {"units": "s-1"})},
+        attrs={"model": "test", "law": "baumgarte", "scheme": "rk4"},
+    )  # fmt: skip
+    fig = drawn_figure(monkeypatch, getattr(plots, draw), ds, tmp_path / "p.png")
+    renderer = fig.canvas.get_renderer()
+    for ax in fig.axes[:1] if draw == "stability_map" else fig.axes[:2]:
+        assert overlapping_labels(ax.xaxis, renderer) == 0
+        assert [t.get_text() for t in ax.xaxis.get_ticklabels() if t.get_text()]  # labelled
