@@ -55,7 +55,7 @@ def _log_scale(ax, which: str, edges) -> None:
     span a decade or more, the labels are 1 and 3 × 10^k (up to about two and a half
     decades) or the powers of ten: matplotlib's own choice adds 2, 3, 4 and 6 × 10^k up to
     about two decades, and on a map's width those run into each other."""
-    from matplotlib.ticker import LogLocator, NullFormatter
+    from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 
     getattr(ax, f"set_{which}scale")("log")
     span = edges.max() / edges.min()
@@ -64,6 +64,8 @@ def _log_scale(ax, which: str, edges) -> None:
         axis.set_minor_formatter(NullFormatter())
     if 10.0 <= span < 10.0**2.5:
         axis.set_major_locator(LogLocator(subs=(1.0, 3.0)))
+        # every major tick labelled (the default drops the 3s beyond a decade or so)
+        axis.set_major_formatter(LogFormatterSciNotation(minor_thresholds=(np.inf, np.inf)))
 
 
 def _is_log(values) -> bool:
