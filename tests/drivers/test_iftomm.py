@@ -138,10 +138,9 @@ def angular_momentum(model, x):
     out = []
     for row in x:
         q, v = row[:8], row[8:]
-        mass(0.0, q, p, M)
-        full = np.tril(M) + np.tril(M, -1).T  # the generated matrix holds one triangle
+        mass(0.0, q, p, M)  # (the generated function writes both triangles)
         xi = np.array([1.0, 0.0, -q[3], q[2], 0.0, -q[6], q[5], 0.0])
-        out.append(xi @ full @ v)
+        out.append(xi @ M @ v)
     return np.array(out)
 
 
