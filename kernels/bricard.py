@@ -474,570 +474,62 @@ def f_accel(t, q, v, p, out):
     y5_dot = v[13]
     z5_dot = v[14]
     L = p[2]
-    e0 = (1.0 / L)
-    e1 = e0 * x1_dot
-    e2 = e0 * z1_dot
-    e3 = (1.0 / (L * L))
-    e4 = e3 * y2_dot
-    e5 = e3 * y2
-    e6 = e3 * y3_dot
-    e7 = e3 * y3
-    e8 = e3 * x1
-    e9 = e3 * x1_dot
-    e10 = e3 * z1
-    e11 = e3 * z1_dot
-    e12 = (1.0 / (L * L * L))
-    e13 = e12 * x4
-    e14 = e13 * x1
-    e15 = e12 * z3
-    e16 = e15 * x4_dot
-    e17 = e12 * x1
-    e18 = x3 * z4_dot
-    e19 = e12 * z4
-    e20 = e19 * x1
-    e21 = e19 * x3
-    e22 = e12 * x4 * z3 - e21
-    e23 = e13 * y2
-    e24 = e12 * z1
-    e25 = e24 * y2
-    e26 = e17 * z4_dot
-    e27 = e19 * y2
-    e28 = e12 * x4 * z1 - e20
-    e29 = e13 * z1
-    e30 = e19 * z1
-    e31 = e17 * y2
-    e32 = e15 * x1_dot
-    e33 = e12 * x3
-    e34 = y2 * z1_dot
-    e35 = -e10 * x3 + e8 * z3
-    e36 = e0 * e35
-    e37 = y2 * y4_dot
-    e38 = e12 * y4
-    e39 = e38 * x1
-    e40 = e13 * z2
-    e41 = e38 * y2
-    e42 = e13 * x2 + e41
-    e43 = -e0 * x1 * x2 - e0 * z1 * z2
-    e44 = e3 * e43
-    e45 = x1 * x2_dot
-    e46 = e24 * y3
-    e47 = z1 * z2_dot
-    e48 = e5 * y3
-    e49 = e3 * z2 * z3 + e48
-    e50 = e0 * e49
-    e51 = e19 * x2
-    e52 = e38 * z1
-    e53 = -e19 * z2 - e41
-    e54 = y2_dot * y3
-    e55 = z1_dot * z2
-    e56 = -e3 * x2 * x3 - e48
-    e57 = e19 * y3
-    e58 = e12 * y4 * z3 - e57
-    e59 = e0 * e56
-    e60 = e38 * x3
-    e61 = e12 * x4 * y3 - e60
-    e62 = (1.0 / L**4)
-    e63 = e62 * x1
-    e64 = x3 * y5
-    e65 = e62 * z3
-    e66 = e65 * y5
-    e67 = e66 * z4_dot
-    e68 = e62 * y4
-    e69 = e68 * x3
-    e70 = x1 * x5_dot
-    e71 = x1 * z3
-    e72 = e68 * z5_dot
-    e73 = e62 * x4
-    e74 = e73 * y5
-    e75 = e68 * x5
-    e76 = e75 * x1
-    e77 = e74 * x1 - e76
-    e78 = e68 * z5
-    e79 = e78 * x1
-    e80 = e62 * x1 * y5 * z4 - e79
-    e81 = x3 * x5
-    e82 = z3 * z5
-    e83 = e62 * e82
-    e84 = -e63 * e81 - e83 * x1
-    e85 = e13 * x3
-    e86 = e15 * z4
-    e87 = e85 * x1 + e86 * x1
-    e88 = e0 * y5_dot
-    e89 = e85 + e86
-    e90 = e0 * e89 * y5 - e68 * e81 - e68 * e82
-    e91 = e63 * y2
-    e92 = e91 * y5
-    e93 = y5 * z4_dot
-    e94 = e62 * y2
-    e95 = e94 * z1
-    e96 = e70 * y2
-    e97 = y2 * z1
-    e98 = e74 * y2 - e75 * y2
-    e99 = e62 * y2 * y5 * z4 - e78 * y2
-    e100 = x5 * y2
-    e101 = e100 * e63
-    e102 = z1 * z5
-    e103 = e102 * e94
-    e104 = -e101 - e103
-    e105 = e23 * x1
-    e106 = e27 * z1
-    e107 = e105 + e106
-    e108 = e78 * z1
-    e109 = e14 + e30
-    e110 = e0 * e109 * y5 - e108 - e76
-    e111 = e62 * y5
-    e112 = x3 * z1
-    e113 = z1 * z3
-    e114 = -e75 * z1
-    e115 = e114 + e74 * z1
-    e116 = -e108 + e62 * y5 * z1 * z4
-    e117 = e62 * e81
-    e118 = -e117 * z1 - e83 * z1
-    e119 = e29 * x3 + e86 * z1
-    e120 = e100 * z1
-    e121 = e120 * e62
-    e122 = y3_dot * y5
-    e123 = x2 * y5
-    e124 = -e100 * e65 + e123 * e65
-    e125 = -e112 * e5 + e5 * e71
-    e126 = e125 * e3
-    e127 = e3 * e49
-    e128 = e127 * y5 + e81 * e94
-    e129 = e3 * e35
-    e130 = -e129 * x5 + e62 * y3 * y5 * z1
-    e131 = e12 * e43
-    e132 = e131 * y5
-    e133 = -e101 - e132
-    e134 = e0 * e43
-    e135 = -e134 * z3 + e3 * y2 * y3 * z1
-    e136 = e135 * e3
-    e137 = e111 * x3
-    e138 = e91 * z5
-    e139 = x3 * z5
-    e140 = -e139 * e94 + e62 * x3 * y5 * z2
-    e141 = e63 * y3
-    e142 = e129 * z5 + e141 * y5
-    e143 = e3 * e56
-    e144 = -e143 * y5 + e62 * y2 * z3 * z5
-    e145 = -e103 - e132
-    e146 = e134 * x3 - e48 * x1
-    e147 = e146 * e3
-    e148 = e68 * z3
-    e149 = e73 * e97
-    e150 = e68 * y3_dot
-    e151 = e12 * x4 * y2 * z3 - e15 * x2 * y4
-    e152 = e38 * y3
-    e153 = -e152 * z1 + e36 * x4
-    e154 = e0 * y2_dot
-    e155 = -e50 * y4 - e85 * y2
-    e156 = e44 * y4
-    e157 = e105 + e156
-    e158 = e0 * z3_dot
-    e159 = x1 * y2
-    e160 = e62 * z4
-    e161 = e159 * z3_dot
-    e162 = e21 * y2 - e60 * z2
-    e163 = e106 + e156
-    e164 = e0 * x3_dot
-    e165 = e59 * y4 - e86 * y2
-    e166 = -e152 * x1 - e36 * z4
-    e167 = e123 * e73 - e75 * x2
-    e168 = -e102 * e73 + e62 * x5 * z1 * z4
-    e169 = e131 * x5
-    e170 = e13 * e43
-    e171 = e0 * x5_dot
-    e172 = e73 * z5
-    e173 = e27 - e38 * z2
-    e174 = e0 * x5
-    e175 = -e172 * y2 + e173 * e174 + e74 * z2
-    e176 = e160 * x5
-    e177 = e172 * x1 - e176 * x1
-    e178 = e62 * y5 * z2 * z4 - e78 * z2
-    e179 = e131 * z5
-    e180 = e19 * e43
-    e181 = e0 * z5_dot
-    e182 = e12 * x4 * y2 - e38 * x2
-    e183 = e0 * z5
-    e184 = -e100 * e160 + e123 * e160 + e182 * e183
-    e185 = e62 * y3
-    e186 = -e102 * e185 - e141 * x5
-    e187 = -e117 * z2 - e127 * z5
-    e188 = e143 * x5 - e83 * x2
-    e189 = e0 * x2_dot
-    e190 = e13 * x1 * y3 + e57 * z1
-    e191 = e0 * y3_dot
-    e192 = e0 * z2_dot
-    e193 = e50 * z4 + e85 * z2
-    e194 = e12 * x2 * z3 * z4 - e59 * x4
-    e195 = e160 * y5
-    e196 = -e152 - e85
-    e197 = e160 * e81 + e183 * e196 + e195 * y3
-    e198 = -e152 - e86
-    e199 = e174 * e198 + e73 * e82 + e74 * y3
-    e200 = (1.0 / L**5)
-    e201 = e200 * y4
-    e202 = e201 * x1
-    e203 = x5 * z3_dot
-    e204 = e201 * x5_dot
-    e205 = e202 * x3
-    e206 = e201 * z5
-    e207 = e206 * x3_dot
-    e208 = e62 * x5 * y4 * z3 - e78 * x3
-    e209 = -e139 * e63 + e62 * x1 * x5 * z3
-    e210 = e0 * y4_dot
-    e211 = e201 * x5
-    e212 = e201 * z5_dot
-    e213 = e206 * y2
-    e214 = -e114 - e79
-    e215 = -e138 + e62 * x5 * y2 * z1
-    e216 = x5 * z1
-    e217 = -e102 * e62 * x3 + e62 * x5 * z1 * z3
-    e218 = e100 * x1
-    e219 = e200 * z3_dot
-    e220 = e100 * z3
-    e221 = e12 * e35
-    e222 = e221 * x5
-    e223 = e12 * e125
-    e224 = e161 * e200
-    e225 = e200 * y2
-    e226 = e221 * z5
-    e227 = e200 * e97
-    e228 = e200 * x4_dot
-    e229 = e225 * z4_dot
-    e230 = e73 * x5
-    e231 = e230 * z1
-    e232 = e102 * e160 + e231
-    e233 = e62 * z5
-    e234 = e43 * y4_dot
-    e235 = e100 * e73
-    e236 = e173 * e183 + e235
-    e237 = e3 * z5_dot
-    e238 = e218 * e228
-    e239 = e159 * e200
-    e240 = e239 * z4
-    e241 = e230 * x1
-    e242 = e160 * z5
-    e243 = -e241 - e242 * x1
-    e244 = e62 * x5
-    e245 = e3 * x5_dot
-    e246 = -e174 * e182 - e242 * y2
-    e247 = e228 * e81
-    e248 = e201 * y3_dot
-    e249 = e203 * z2
-    e250 = x3 * z2
-    e251 = e127 * x5
-    e252 = -e233 * e250 + e251
-    e253 = -e174 * e196 + e62 * x3 * z4 * z5
-    e254 = e65 * x2 * x5
-    e255 = e143 * z5 + e254
-    e256 = e183 * e198 - e230 * z3
-    e257 = e201 * x3
-    e258 = e163 * e3
-    e259 = e12 * e146
-    e260 = (
-        e11 * e162 - e159 * e248 + e165 * e9 + e166 * e4 - e223 * z4_dot - e224 * z4 - e257 * e45
-        - e257 * e47 + e258 * x3_dot + e259 * y4_dot
-    )
-    e261 = -e141 * z5 + e62 * x5 * y3 * z1
-    e262 = e43 * x3_dot
-    e263 = e43 * z3_dot
-    e264 = e12 * e135
-    e265 = e264 * x5_dot
-    e266 = e200 * x1
-    e267 = e266 * y4_dot
-    e268 = e200 * z4_dot
-    e269 = e266 * z4
-    e270 = e68 * y5
-    e271 = e270 * x1
-    e272 = e241 + e271
-    e273 = e174 * e89 + e270 * x3
-    e274 = e201 * y5_dot
-    e275 = x5 * z4
-    e276 = e235 + e270 * y2
-    e277 = e109 * e174 + e271
-    e278 = e200 * y4_dot * y5
-    e279 = e231 + e270 * z1
-    e280 = e200 * e275
-    e281 = e176 * x2 + e195 * y2
-    e282 = e43 * x5_dot
-    e283 = -e169 + e62 * x1 * y2 * y5
-    e284 = e0 * z4_dot
-    e285 = e200 * e81
-    e286 = e200 * y3_dot
-    e287 = e266 * e54
-    e288 = e12 * e56
-    e289 = e200 * e64
-    e290 = e288 * y5
-    e291 = -e195 * x3 + e62 * x5 * y3 * z4
-    e292 = e3 * y5_dot
-    e293 = e251 - e64 * e94
-    e294 = e0 * y5
-    e295 = -e173 * e294 + e62 * x4 * x5 * z2
-    e296 = x4_dot * x5
-    e297 = y5 * z4
-    e298 = e297 * z1
-    e299 = e129 * y5 + e185 * e216
-    e300 = -e198 * e294 + e62 * x4 * x5 * y3
-    e301 = e200 * x5 * z3
-    e302 = e254 + e66 * y2
-    e303 = e123 * e68 + e230 * x2
-    out[0] = 2.0 * (x1_dot * x1_dot) + 2.0 * (y1_dot * y1_dot) + 2.0 * (z1_dot * z1_dot)
-    out[1] = 2.0 * (x2_dot * x2_dot) + 2.0 * (y2_dot * y2_dot) + 2.0 * (z2_dot * z2_dot)
-    out[2] = 2.0 * (x3_dot * x3_dot) + 2.0 * (y3_dot * y3_dot) + 2.0 * (z3_dot * z3_dot)
-    out[3] = 2.0 * (x4_dot * x4_dot) + 2.0 * (y4_dot * y4_dot) + 2.0 * (z4_dot * z4_dot)
-    out[4] = 2.0 * (x5_dot * x5_dot) + 2.0 * (y5_dot * y5_dot) + 2.0 * (z5_dot * z5_dot)
+    e0 = x1 * y2_dot
+    e1 = x1_dot * y2_dot
+    e2 = x1_dot * y2
+    e3 = y2 * z1_dot
+    e4 = y2_dot * z1
+    e5 = y2_dot * z1_dot
+    e6 = x1_dot * x2_dot + z1_dot * z2_dot
+    e7 = x1 * x2_dot + x1_dot * x2 + z1 * z2_dot + z1_dot * z2
+    e8 = e0 * z3_dot + e1 * z3 + e2 * z3_dot - e3 * x3_dot - e4 * x3_dot - e5 * x3
+    e9 = x1 * y2
+    e10 = x1 * z3
+    e11 = x3 * z1
+    e12 = y2 * z1
+    e13 = e10 * y2_dot - e11 * y2_dot - e12 * x3_dot + e2 * z3 - e3 * x3 + e9 * z3_dot
+    e14 = e3 * y3_dot + e4 * y3_dot + e5 * y3 + e6 * z3 + e7 * z3_dot
+    e15 = x1 * x2 + z1 * z2
+    e16 = e12 * y3_dot + e15 * z3_dot + e3 * y3 + e4 * y3 + e7 * z3
+    e17 = e0 * y3_dot + e1 * y3 + e2 * y3_dot + e6 * x3 + e7 * x3_dot
+    e18 = e0 * y3 + e15 * x3_dot + e2 * y3 + e7 * x3 + e9 * y3_dot
+    e19 = y2 * (e10 - e11)
+    e20 = e15 * x3 + e9 * y3
+    e21 = e13 * z4 + e18 * y4 + e19 * z4_dot + e20 * y4_dot
+    e22 = e12 * y3 + e15 * z3
+    e23 = e13 * x4 - e16 * y4 + e19 * x4_dot - e22 * y4_dot
+    e24 = e16 * z4 + e18 * x4 + e20 * x4_dot + e22 * z4_dot
+    e25 = e13 * z4_dot + e17 * y4 + e18 * y4_dot + e8 * z4
+    e26 = e13 * x4_dot - e14 * y4 - e16 * y4_dot + e8 * x4
+    e27 = e14 * z4 + e16 * z4_dot + e17 * x4 + e18 * x4_dot
+    e28 = 2.0 / L**5
+    out[0] = 2.0 * ((x1_dot * x1_dot) + (y1_dot * y1_dot) + (z1_dot * z1_dot))
+    out[1] = 2.0 * ((x2_dot * x2_dot) + (y2_dot * y2_dot) + (z2_dot * z2_dot))
+    out[2] = 2.0 * ((x3_dot * x3_dot) + (y3_dot * y3_dot) + (z3_dot * z3_dot))
+    out[3] = 2.0 * ((x4_dot * x4_dot) + (y4_dot * y4_dot) + (z4_dot * z4_dot))
+    out[4] = 2.0 * ((x5_dot * x5_dot) + (y5_dot * y5_dot) + (z5_dot * z5_dot))
     out[5] = 0.0
-    out[6] = 2.0 * e1 * z2_dot - 2.0 * e2 * x2_dot
+    out[6] = 2.0 * (x1_dot * z2_dot - x2_dot * z1_dot) / L
     out[7] = (
-        x1_dot * (e3 * x3 * y2_dot + e3 * x3_dot * y2 - e6 * x2 - e7 * x2_dot)
-        + x2_dot * (-e6 * x1 - e7 * x1_dot) + x3_dot * (e4 * x1 + e5 * x1_dot)
-        + y2_dot * (e10 * z3_dot + e11 * z3 + e8 * x3_dot + e9 * x3)
-        + y3_dot * (-e10 * z2_dot - e11 * z2 - e8 * x2_dot - e9 * x2)
-        + z1_dot * (e4 * z3 + e5 * z3_dot - e6 * z2 - e7 * z2_dot)
-        + z2_dot * (-e6 * z1 - e7 * z1_dot) + z3_dot * (e4 * z1 + e5 * z1_dot)
+        2.0
+        * (
+              e0 * x3_dot + e1 * x3 + e2 * x3_dot + e3 * z3_dot + e4 * z3_dot + e5 * z3 - e6 * y3
+              - e7 * y3_dot
+          )
+         / (L * L)
     )
     out[8] = (
-        x1_dot
-        * (
-              e15 * e37 + e16 * x2 + e22 * x2_dot - e27 * y3_dot + e42 * z3_dot - e51 * x3_dot
-              + e58 * y2_dot + e59 * z4_dot
-          )
-         + x2_dot * (e14 * z3_dot + e16 * x1 - e17 * e18 - e20 * x3_dot + e22 * x1_dot)
-        + x3_dot
-          * (
-                -e20 * x2_dot - e24 * e37 + e3 * e43 * z4_dot - e30 * z2_dot - e51 * x1_dot
-                - e52 * y2_dot + e53 * z1_dot
-            )
-         + x4_dot
-        * (
-              e15 * e45 + e15 * e47 + e25 * y3_dot + e32 * x2 - e44 * z3_dot + e46 * y2_dot
-              + e50 * z1_dot
-          )
-         + y2_dot
-        * (
-              -e26 * y3 + e28 * y3_dot + e36 * y4_dot + e39 * z3_dot + e46 * x4_dot - e52 * x3_dot
-              + e58 * x1_dot + e61 * z1_dot
-          )
-         + y3_dot * (e23 * z1_dot + e25 * x4_dot - e26 * y2 - e27 * x1_dot + e28 * y2_dot)
-        + y4_dot * (-e25 * x3_dot + e31 * z3_dot + e32 * y2 - e33 * e34 + e36 * y2_dot)
-        + z1_dot
-          * (
-                -e12 * e18 * z2 + e22 * z2_dot + e23 * y3_dot - e33 * e37 + e40 * z3_dot
-                + e50 * x4_dot + e53 * x3_dot + e61 * y2_dot
-            )
-         + z2_dot * (e16 * z1 - e18 * e24 + e22 * z1_dot + e29 * z3_dot - e30 * x3_dot)
-        + z3_dot
-          * (
-                e14 * x2_dot + e17 * e37 + e29 * z2_dot + e39 * y2_dot + e40 * z1_dot + e42 * x1_dot
-                - e44 * x4_dot
-            )
-         + z4_dot
-        * (
-              e0 * e56 * x1_dot - e17 * e54 - e17 * x2_dot * x3 - e24 * x3 * z2_dot
-              + e3 * e43 * x3_dot - e31 * y3_dot - e33 * e55
-          )
+        2.0 * (e13 * y4_dot + e14 * x4 + e16 * x4_dot - e17 * z4 - e18 * z4_dot + e8 * y4)
+        / (L * L * L)
     )
     out[9] = (
-        x1_dot
-        * (
-              e124 * z4_dot + e144 * x4_dot + e151 * e181 + e165 * e171 + e167 * x3_dot
-              + e184 * z3_dot + e188 * y4_dot + e194 * e88 + e199 * y2_dot + e90 * x2_dot
-              + e98 * y3_dot
-          )
-         + x2_dot
-        * (
-              e63 * e64 * x4_dot + e67 * x1 - e69 * e70 - e71 * e72 + e77 * x3_dot + e80 * z3_dot
-              + e84 * y4_dot + e87 * e88 + e90 * x1_dot
-          )
-         + x3_dot
-        * (
-              e115 * z2_dot + e121 * z4_dot + e145 * x4_dot - e149 * z5_dot + e163 * e171
-              + e167 * x1_dot + e168 * y2_dot + e169 * y4_dot - e170 * y5_dot + e175 * z1_dot
-              + e77 * x2_dot
-          )
-         + x4_dot
-        * (
-              e126 * z5_dot + e137 * e45 + e137 * e47 + e138 * z3_dot + e140 * z1_dot
-              + e142 * y2_dot + e144 * x1_dot + e145 * x3_dot - e147 * y5_dot + e92 * y3_dot
-          )
-         + x5_dot
-        * (
-              e1 * e165 - e126 * z4_dot + e147 * y4_dot - e150 * e159 + e154 * e166 - e160 * e161
-              + e162 * e2 + e163 * e164 - e45 * e69 - e47 * e69
-          )
-         + y2_dot
-        * (
-              e110 * y3_dot + e130 * z4_dot + e142 * x4_dot + e153 * e181 + e166 * e171
-              + e168 * x3_dot + e177 * z3_dot + e186 * y4_dot + e190 * e88 + e197 * z1_dot
-              + e199 * x1_dot
-          )
-         + y3_dot
-        * (
-              e104 * y4_dot + e107 * e88 + e110 * y2_dot - e68 * e96 - e72 * e97 + e92 * x4_dot
-              + e93 * e95 + e98 * x1_dot + e99 * z1_dot
-          )
-         + y4_dot
-        * (
-              e104 * y3_dot + e118 * z2_dot - e136 * z5_dot + e147 * x5_dot + e169 * x3_dot
-              + e179 * z3_dot + e186 * y2_dot + e187 * z1_dot + e188 * x1_dot + e84 * x2_dot
-          )
-         + y5_dot
-        * (
-              e1 * e194 + e107 * e191 + e119 * e192 + e136 * z4_dot - e147 * x4_dot + e154 * e190
-              - e170 * x3_dot - e180 * z3_dot + e189 * e87 + e193 * e2
-          )
-         + z1_dot
-        * (
-              e128 * z4_dot + e140 * x4_dot + e155 * e181 + e162 * e171 + e175 * x3_dot
-              + e178 * z3_dot + e187 * y4_dot + e193 * e88 + e197 * y2_dot + e90 * z2_dot
-              + e99 * y3_dot
-          )
-         + z2_dot
-        * (
-              e111 * e112 * x4_dot - e112 * e68 * x5_dot - e113 * e72 + e115 * x3_dot
-              + e116 * z3_dot + e118 * y4_dot + e119 * e88 + e67 * z1 + e90 * z1_dot
-          )
-         + z3_dot
-        * (
-              e116 * z2_dot + e133 * z4_dot + e138 * x4_dot + e157 * e181 - e160 * e96
-              + e177 * y2_dot + e178 * z1_dot + e179 * y4_dot - e180 * y5_dot + e184 * x1_dot
-              + e80 * x2_dot
-          )
-         + z4_dot
-        * (
-              e121 * x3_dot + e122 * e95 + e124 * x1_dot - e126 * x5_dot + e128 * z1_dot
-              + e130 * y2_dot + e133 * z3_dot + e136 * y5_dot + e45 * e66 + e47 * e66
-          )
-         + z5_dot
-        * (
-              e1 * e151 + e126 * x4_dot - e136 * y4_dot - e148 * e45 - e148 * e47 - e149 * x3_dot
-              - e150 * e97 + e153 * e154 + e155 * e2 + e157 * e158
-          )
+        2.0 * (-e21 * x5_dot + e23 * z5_dot + e24 * y5_dot - e25 * x5 + e26 * z5 + e27 * y5) / L**4
     )
     out[10] = 0.0
     out[11] = 0.0
     out[12] = 0.0
-    out[13] = (
-        e260 * z5_dot
-        + x1_dot
-          * (
-                -e151 * e245 + e154 * e256 + e158 * e246 + e165 * e237 + e189 * e208 - e207 * x2
-                + e210 * e255 - e213 * y3_dot - e220 * e228 - e229 * e82
-            )
-         + x2_dot * (e1 * e208 + e202 * e203 + e204 * e71 - e205 * z5_dot - e207 * x1 + e209 * e210)
-        + x3_dot
-          * (
-                e102 * e229 + e120 * e228 + e154 * e232 + e163 * e237 + e2 * e236 - e206 * e45
-                - e206 * e47 - e206 * x1_dot * x2 + e227 * x4 * x5_dot + e233 * e234
-            )
-         + x4_dot
-        * (
-              -e200 * e220 * x1_dot + e200 * x3 * x5 * y2 * z1_dot + e200 * x3_dot * x5 * y2 * z1
-              - e218 * e219 - e222 * y2_dot - e223 * x5_dot
-          )
-         + x5_dot
-        * (
-              -e11 * e155 + e12 * e135 * y4_dot - e151 * e9 - e153 * e4 - e157 * e3 * z3_dot
-              + e200 * x1 * x2_dot * y4 * z3 + e200 * x3_dot * x4 * y2 * z1
-              + e200 * y2 * y3_dot * y4 * z1 + e200 * y4 * z1 * z2_dot * z3 - e223 * x4_dot
-          )
-         + y2_dot
-        * (
-              e1 * e256 - e153 * e245 + e158 * e243 + e164 * e232 + e166 * e237 + e191 * e214
-              + e2 * e253 + e210 * e261 - e222 * x4_dot - e226 * z4_dot
-          )
-         + y3_dot
-        * (e154 * e214 - e159 * e212 + e204 * e97 + e210 * e215 + e211 * e34 - e213 * x1_dot)
-         + y4_dot
-        * (
-              e1 * e255 + e154 * e261 + e189 * e209 + e191 * e215 + e192 * e217 + e2 * e252
-              + e233 * e262 - e244 * e263 + e259 * z5_dot + e265
-          )
-         + z1_dot
-        * (
-              e100 * e248 + e154 * e253 - e155 * e245 + e162 * e237 + e164 * e236 + e18 * e225 * z5
-              + e192 * e208 + e201 * e249 + e210 * e252 + e247 * y2
-          )
-         + z2_dot
-        * (
-              -e102 * e201 * x3_dot - e112 * e212 + e113 * e204 + e2 * e208 + e201 * e216 * z3_dot
-              + e210 * e217
-          )
-         + z3_dot
-        * (
-              e1 * e246 + e154 * e243 - e157 * e245 + e211 * e45 + e211 * e47 + e211 * e55
-              - e234 * e244 - e238 - e239 * z4_dot * z5 - e240 * z5_dot
-          )
-         + z4_dot
-        * (
-              e200 * x3 * y2 * z1_dot * z5 + e200 * x3_dot * y2 * z1 * z5 - e223 * z5_dot
-              - e224 * z5 - e225 * e82 * x1_dot - e226 * y2_dot
-          )
-    )
-    out[14] = (
-        -e260 * y5_dot
-        + x1_dot
-          * (
-                e154 * e300 + e158 * e281 + e164 * e303 - e165 * e292 + e189 * e273 + e191 * e276
-                + e194 * e245 + e284 * e302 - e288 * e296 - e290 * y4_dot
-            )
-         + x2_dot
-        * (
-              e1 * e273 + e164 * e272 + e203 * e269 + e205 * y5_dot + e245 * e87 + e247 * x1
-              + e267 * e64 + e268 * e71 * x5
-          )
-         + x3_dot
-        * (
-              e0 * e272 * x2_dot + e0 * e279 * z2_dot + e0 * e295 * z1_dot + e0 * e303 * x1_dot
-              - e111 * e234 - e200 * e298 * y2_dot - e227 * e93 - e244 * e43 * x4_dot
-              - e258 * y5_dot - e282 * e73
-          )
-         + x4_dot
-        * (
-              e218 * e286 - e244 * e262 - e259 * x5_dot + e285 * e45 + e285 * e47 + e285 * e55
-              + e287 * x5 - e288 * x1_dot * x5
-          )
-         + x5_dot
-        * (
-              e107 * e6 + e11 * e193 + e119 * e3 * z2_dot - e160 * e263 + e190 * e4 + e194 * e9
-              - e259 * x4_dot - e262 * e73 + e264 * z4_dot + e3 * e87 * x2_dot
-          )
-         + y2_dot
-        * (
-              e1 * e300 - e166 * e292 + e190 * e245 + e191 * e277 + e2 * e291 - e200 * e298 * x3_dot
-              + e219 * e297 * x1 + e266 * e296 * y3 + e267 * y3 * y5 + e284 * e299
-          )
-         + y3_dot
-        * (
-              e1 * e276 + e107 * e245 + e120 * e268 + e154 * e277 + e159 * e274 + e200 * e275 * e34
-              + e238 + e266 * e37 * y5
-          )
-         + y4_dot
-        * (
-              -e111 * e262 + e122 * e239 - e259 * y5_dot + e287 * y5 + e289 * e45 + e289 * e47
-              + e289 * e55 - e290 * x1_dot
-          )
-         + z1_dot
-        * (
-              e100 * e286 * z4 + e154 * e291 - e162 * e292 + e164 * e295 + e192 * e273 + e193 * e245
-              + e200 * e249 * z4 + e247 * z2 + e250 * e278 + e284 * e293
-          )
-         + z2_dot
-        * (
-              e112 * e274 + e112 * e278 + e119 * e245 + e164 * e279 + e2 * e273 + e216 * e219 * z4
-              + e216 * e268 * z3 + e247 * z1
-          )
-         + z3_dot
-        * (
-              e1 * e281 - e160 * e282 + e240 * y5_dot + e269 * y2_dot * y5 + e280 * e45 + e280 * e47
-              + e280 * e55 + e283 * e284
-          )
-         + z4_dot
-        * (
-              e1 * e302 + e120 * e286 + e154 * e299 + e158 * e283 + e2 * e293 + e223 * y5_dot
-              - e227 * x3_dot * y5 + e265 + e301 * e45 + e301 * e47
-          )
-    )
+    out[13] = -e28 * (e21 * z5_dot + e23 * x5_dot + e25 * z5 + e26 * x5)
+    out[14] = e28 * (e21 * y5_dot + e24 * x5_dot + e25 * y5 + e27 * x5)
 
 
 @njit(cache=True)
@@ -1068,66 +560,67 @@ def energy(t, q, v, p):
     e5 = (y1_dot * y1_dot)
     e6 = (z1_dot * z1_dot)
     e7 = (L * L)
-    e8 = m * ((a * a) + e7) / e7
-    e9 = 0.041666666666666664 * e8
-    e10 = x1_dot + 0.5 * x2_dot
-    e11 = y1_dot + 0.5 * y2_dot
-    e12 = z1_dot + 0.5 * z2_dot
-    e13 = x1_dot + x2_dot
-    e14 = e13 + 0.5 * x3_dot
-    e15 = y1_dot + y2_dot
-    e16 = e15 + 0.5 * y3_dot
-    e17 = z1_dot + z2_dot
-    e18 = e17 + 0.5 * z3_dot
-    e19 = e13 + x3_dot
-    e20 = e19 + x4_dot + 0.5 * x5_dot
-    e21 = 0.08333333333333333 * e8
-    e22 = e15 + y3_dot
-    e23 = e22 + y4_dot + 0.5 * y5_dot
-    e24 = e17 + z3_dot
-    e25 = e24 + z4_dot + 0.5 * z5_dot
-    e26 = e19 + 0.5 * x4_dot
-    e27 = e22 + 0.5 * y4_dot
-    e28 = e24 + 0.5 * z4_dot
-    e29 = 2.0 * x1_dot
-    e30 = e29 + 2.0 * x2_dot
-    e31 = e30 + 2.0 * x3_dot
-    e32 = e0 * (e31 + 2.0 * x4_dot + x5_dot)
-    e33 = 2.0 * y1_dot
-    e34 = e33 + 2.0 * y2_dot
-    e35 = e34 + 2.0 * y3_dot
-    e36 = e0 * (e35 + 2.0 * y4_dot + y5_dot)
-    e37 = 2.0 * z1_dot
-    e38 = e37 + 2.0 * z2_dot
-    e39 = e38 + 2.0 * z3_dot
-    e40 = e0 * (e39 + 2.0 * z4_dot + z5_dot)
-    e41 = e0 * (e31 + x4_dot) + e32
-    e42 = e0 * (e35 + y4_dot) + e36
-    e43 = e0 * (e39 + z4_dot) + e40
-    e44 = e0 * (e30 + x3_dot) + e41
-    e45 = e0 * (e34 + y3_dot) + e42
-    e46 = e0 * (e38 + z3_dot) + e43
-    e47 = 0.25 * m
+    e8 = 0.041666666666666664 * m * ((a * a) + e7) / e7
+    e9 = (x2_dot * x2_dot)
+    e10 = (y2_dot * y2_dot)
+    e11 = (z2_dot * z2_dot)
+    e12 = (x3_dot * x3_dot)
+    e13 = (y3_dot * y3_dot)
+    e14 = (z3_dot * z3_dot)
+    e15 = (x4_dot * x4_dot)
+    e16 = (y4_dot * y4_dot)
+    e17 = (z4_dot * z4_dot)
+    e18 = (x5_dot * x5_dot)
+    e19 = (y5_dot * y5_dot)
+    e20 = (z5_dot * z5_dot)
+    e21 = x1_dot + 0.5 * x2_dot
+    e22 = y1_dot + 0.5 * y2_dot
+    e23 = z1_dot + 0.5 * z2_dot
+    e24 = x1_dot + x2_dot
+    e25 = e24 + 0.5 * x3_dot
+    e26 = y1_dot + y2_dot
+    e27 = e26 + 0.5 * y3_dot
+    e28 = z1_dot + z2_dot
+    e29 = e28 + 0.5 * z3_dot
+    e30 = e24 + x3_dot
+    e31 = e30 + 0.5 * x4_dot
+    e32 = e26 + y3_dot
+    e33 = e32 + 0.5 * y4_dot
+    e34 = e28 + z3_dot
+    e35 = e34 + 0.5 * z4_dot
+    e36 = e30 + x4_dot + 0.5 * x5_dot
+    e37 = e32 + y4_dot + 0.5 * y5_dot
+    e38 = e34 + z4_dot + 0.5 * z5_dot
+    e39 = 2.0 * x1_dot
+    e40 = 2.0 * y1_dot
+    e41 = 2.0 * z1_dot
+    e42 = e39 + 2.0 * x2_dot
+    e43 = e40 + 2.0 * y2_dot
+    e44 = e41 + 2.0 * z2_dot
+    e45 = e42 + 2.0 * x3_dot
+    e46 = e43 + 2.0 * y3_dot
+    e47 = e44 + 2.0 * z3_dot
     return (
-        e0 * g * y1 - e0 * ((e10 * e10) + (e11 * e11) + (e12 * e12))
-        - e0 * ((e14 * e14) + (e16 * e16) + (e18 * e18))
-        - e0 * ((e20 * e20) + (e23 * e23) + (e25 * e25))
-        - e0 * ((e26 * e26) + (e27 * e27) + (e28 * e28)) - e0 * (0.25 * e4 + 0.25 * e5 + 0.25 * e6)
-        + e1 * (e2 + 0.5 * y3) + e1 * (e3 + 0.5 * y4) + e1 * (y1 + 0.5 * y2)
-        + e1 * (e3 + y4 + 0.5 * y5) - e9 * (e4 + e5 + e6)
-        - e9 * ((x2_dot * x2_dot) + (y2_dot * y2_dot) + (z2_dot * z2_dot))
-        - e9 * ((x3_dot * x3_dot) + (y3_dot * y3_dot) + (z3_dot * z3_dot))
-        - e9 * ((x4_dot * x4_dot) + (y4_dot * y4_dot) + (z4_dot * z4_dot))
-        - e9 * ((x5_dot * x5_dot) + (y5_dot * y5_dot) + (z5_dot * z5_dot))
-        + x1_dot * (e0 * (e29 + x2_dot) + e21 * x1_dot + e44 + e47 * x1_dot)
-        + x2_dot * (e0 * e10 + e21 * x2_dot + e44) + x3_dot * (e0 * e14 + e21 * x3_dot + e41)
-        + x4_dot * (e0 * e26 + e21 * x4_dot + e32) + x5_dot * (e0 * e20 + e21 * x5_dot)
-        + y1_dot * (e0 * (e33 + y2_dot) + e21 * y1_dot + e45 + e47 * y1_dot)
-        + y2_dot * (e0 * e11 + e21 * y2_dot + e45) + y3_dot * (e0 * e16 + e21 * y3_dot + e42)
-        + y4_dot * (e0 * e27 + e21 * y4_dot + e36) + y5_dot * (e0 * e23 + e21 * y5_dot)
-        + z1_dot * (e0 * (e37 + z2_dot) + e21 * z1_dot + e46 + e47 * z1_dot)
-        + z2_dot * (e0 * e12 + e21 * z2_dot + e46) + z3_dot * (e0 * e18 + e21 * z3_dot + e43)
-        + z4_dot * (e0 * e28 + e21 * z4_dot + e40) + z5_dot * (e0 * e25 + e21 * z5_dot)
+        e0 * g * y1 - e0 * ((e21 * e21) + (e22 * e22) + (e23 * e23))
+        - e0 * ((e25 * e25) + (e27 * e27) + (e29 * e29))
+        - e0 * ((e31 * e31) + (e33 * e33) + (e35 * e35))
+        - e0 * ((e36 * e36) + (e37 * e37) + (e38 * e38)) - e0 * (0.25 * e4 + 0.25 * e5 + 0.25 * e6)
+        + e0 * (0.5 * e4 + 0.5 * e5 + 0.5 * e6)
+        + e0 * (e21 * (e39 + x2_dot) + e22 * (e40 + y2_dot) + e23 * (e41 + z2_dot))
+        + e0 * (e25 * (e42 + x3_dot) + e27 * (e43 + y3_dot) + e29 * (e44 + z3_dot))
+        + e0 * (e31 * (e45 + x4_dot) + e33 * (e46 + y4_dot) + e35 * (e47 + z4_dot))
+        + e0
+          * (
+                e36 * (e45 + 2.0 * x4_dot + x5_dot) + e37 * (e46 + 2.0 * y4_dot + y5_dot)
+                + e38 * (e47 + 2.0 * z4_dot + z5_dot)
+            )
+         + e1 * (e2 + 0.5 * y3) + e1 * (e3 + 0.5 * y4) + e1 * (y1 + 0.5 * y2)
+        + e1 * (e3 + y4 + 0.5 * y5) - e8 * (e10 + e11 + e9)
+        + e8 * (2.0 * e10 + 2.0 * e11 + 2.0 * e9) - e8 * (e12 + e13 + e14)
+        + e8 * (2.0 * e12 + 2.0 * e13 + 2.0 * e14) - e8 * (e15 + e16 + e17)
+        + e8 * (2.0 * e15 + 2.0 * e16 + 2.0 * e17) - e8 * (e18 + e19 + e20)
+        + e8 * (2.0 * e18 + 2.0 * e19 + 2.0 * e20) - e8 * (e4 + e5 + e6)
+        + e8 * (2.0 * e4 + 2.0 * e5 + 2.0 * e6)
     )
 
 

@@ -233,66 +233,58 @@ def forces(t, q, v, p, out):
     p10_ = p[10]
     a = p[11]
     e = p[12]
-    e0 = simdmath.cos(psi)
-    e1 = a * e0
-    e2 = e1 * x2_dot
-    e3 = simdmath.sin(psi)
-    e4 = a * e3
-    e5 = e4 * y2_dot
-    e6 = 0.16666666666666666 * m_rod
-    e7 = e1 * x1_dot
-    e8 = e4 * y1_dot
-    e9 = 0.5 * p10_ - s
-    e10 = e9 + 0.5 * z2
-    e11 = e * e3
-    e12 = 0.5 * e4
-    e13 = e11 - e12 + 0.5 * y2
-    e14 = e * e0
-    e15 = 0.5 * e1
-    e16 = e14 - e15 + 0.5 * x2
-    e17 = math.sqrt((e10 * e10) + (e13 * e13) + (e16 * e16))
-    e18 = (1.0 / e17)
-    e19 = -2.0 * e * e3 + e4
-    e20 = e1 - 2.0 * e14
-    e21 = e18 * (-0.5 * e13 * e20 + 0.5 * e16 * e19)
-    e22 = K * (e17 - l0)
-    e23 = e9 + 0.5 * z1
-    e24 = -e11 + e12 + 0.5 * y1
-    e25 = -e14 + e15 + 0.5 * x1
-    e26 = math.sqrt((e23 * e23) + (e24 * e24) + (e25 * e25))
-    e27 = (1.0 / e26)
-    e28 = e27 * (-0.5 * e19 * e25 + 0.5 * e20 * e24)
-    e29 = K * (e26 - l0)
-    e30 = -e10 * e18
-    e31 = 0.25 * p10_ - 0.5 * s
-    e32 = e18 * (e31 + 0.25 * z2)
-    e33 = 0.25 * e1
-    e34 = 0.5 * e14
-    e35 = e18 * (-e33 + e34 + 0.25 * x2)
-    e36 = 0.25 * e4
-    e37 = 0.5 * e11
-    e38 = e18 * (-e36 + e37 + 0.25 * y2)
-    e39 = C * (e21 * psi_dot + e30 * s_dot + e32 * z2_dot + e35 * x2_dot + e38 * y2_dot)
-    e40 = -e23 * e27
-    e41 = e27 * (e31 + 0.25 * z1)
-    e42 = e27 * (e33 - e34 + 0.25 * x1)
-    e43 = e27 * (e36 - e37 + 0.25 * y1)
-    e44 = C * (e28 * psi_dot + e40 * s_dot + e41 * z1_dot + e42 * x1_dot + e43 * y1_dot)
-    e45 = e6 * (psi_dot * psi_dot)
-    e46 = e1 * e45
-    e47 = e4 * e45
-    e48 = g * m_ball + 0.5 * g * m_rod
-    out[0] = (
-        e21 * e22 + e21 * e39 + e28 * e29 + e28 * e44 - e6 * (e2 * psi_dot + e5 * psi_dot)
-        - e6 * (-e7 * psi_dot - e8 * psi_dot) + psi_dot * (e6 * (e2 + e5) + e6 * (-e7 - e8))
-    )
-    out[1] = e22 * e30 + e29 * e40 + e30 * e39 + e40 * e44 + g * m_slider
-    out[2] = e29 * e42 + e42 * e44 - e46
-    out[3] = e29 * e43 + e43 * e44 - e47
-    out[4] = e29 * e41 + e41 * e44 + e48
-    out[5] = e22 * e35 + e35 * e39 + e46
-    out[6] = e22 * e38 + e38 * e39 + e47
-    out[7] = e22 * e32 + e32 * e39 + e48
+    e0 = 0.5 * p10_ - s
+    e1 = e0 + 0.5 * z2
+    e2 = simdmath.sin(psi)
+    e3 = e * e2
+    e4 = a * e2
+    e5 = 0.5 * e4
+    e6 = e3 - e5 + 0.5 * y2
+    e7 = simdmath.cos(psi)
+    e8 = e * e7
+    e9 = a * e7
+    e10 = 0.5 * e9
+    e11 = -e10 + e8 + 0.5 * x2
+    e12 = math.sqrt((e1 * e1) + (e11 * e11) + (e6 * e6))
+    e13 = (1.0 / e12)
+    e14 = -2.0 * e * e2 + e4
+    e15 = -2.0 * e8 + e9
+    e16 = e13 * (0.5 * e11 * e14 - 0.5 * e15 * e6)
+    e17 = K * (e12 - l0)
+    e18 = e0 + 0.5 * z1
+    e19 = -e3 + e5 + 0.5 * y1
+    e20 = e10 - e8 + 0.5 * x1
+    e21 = math.sqrt((e18 * e18) + (e19 * e19) + (e20 * e20))
+    e22 = (1.0 / e21)
+    e23 = e22 * (-0.5 * e14 * e20 + 0.5 * e15 * e19)
+    e24 = K * (e21 - l0)
+    e25 = -e1 * e13
+    e26 = 0.25 * p10_ - 0.5 * s
+    e27 = e13 * (e26 + 0.25 * z2)
+    e28 = 0.25 * e9
+    e29 = 0.5 * e8
+    e30 = e13 * (-e28 + e29 + 0.25 * x2)
+    e31 = 0.25 * e4
+    e32 = 0.5 * e3
+    e33 = e13 * (-e31 + e32 + 0.25 * y2)
+    e34 = C * (e16 * psi_dot + e25 * s_dot + e27 * z2_dot + e30 * x2_dot + e33 * y2_dot)
+    e35 = -e18 * e22
+    e36 = e22 * (e26 + 0.25 * z1)
+    e37 = e22 * (e28 - e29 + 0.25 * x1)
+    e38 = e22 * (e31 - e32 + 0.25 * y1)
+    e39 = C * (e23 * psi_dot + e35 * s_dot + e36 * z1_dot + e37 * x1_dot + e38 * y1_dot)
+    e40 = 0.16666666666666666 * m_rod * (psi_dot * psi_dot)
+    e41 = e40 * e9
+    e42 = e4 * e40
+    e43 = g * m_ball + 0.5 * g * m_rod
+    out[0] = e16 * e17 + e16 * e34 + e23 * e24 + e23 * e39
+    out[1] = e17 * e25 + e24 * e35 + e25 * e34 + e35 * e39 + g * m_slider
+    out[2] = e24 * e37 + e37 * e39 - e41
+    out[3] = e24 * e38 + e38 * e39 - e42
+    out[4] = e24 * e36 + e36 * e39 + e43
+    out[5] = e17 * e30 + e30 * e34 + e41
+    out[6] = e17 * e33 + e33 * e34 + e42
+    out[7] = e17 * e27 + e27 * e34 + e43
 
 
 @njit(cache=True)
@@ -353,33 +345,28 @@ def f_accel(t, q, v, p, out):
     y2_dot = v[6]
     z2_dot = v[7]
     a = p[11]
-    e0 = 2.0 * x1_dot
-    e1 = simdmath.sin(psi)
-    e2 = a * e1
-    e3 = 2.0 * e2
-    e4 = e3 * psi_dot
-    e5 = simdmath.cos(psi)
-    e6 = a * e5
-    e7 = 2.0 * e6
-    e8 = e7 * psi_dot
-    e9 = 2.0 * (a * a)
-    e10 = (e1 * e1) * e9 + (e5 * e5) * e9
-    e11 = 2.0 * y2_dot
-    e12 = e5 * x1_dot
-    e13 = e1 * y1_dot
-    e14 = e5 * x2_dot
-    e15 = e1 * y2_dot
+    e0 = simdmath.sin(psi)
+    e1 = a * e0
+    e2 = e1 * psi_dot
+    e3 = simdmath.cos(psi)
+    e4 = a * e3
+    e5 = e4 * psi_dot
+    e6 = 2.0 * (psi_dot * psi_dot)
+    e7 = e1 * e6
+    e8 = e4 * e6
+    e9 = 2.0 * e3
+    e10 = 2.0 * e0
+    e11 = e3 * psi_dot
     out[0] = (
-        psi_dot
-        * (e0 * e2 - 2.0 * e6 * y1_dot + psi_dot * (e10 + e3 * (-e2 + y1) + e7 * (-e6 + x1)))
-         + x1_dot * (e0 + e4) + y1_dot * (-e8 + 2.0 * y1_dot) + 2.0 * (z1_dot * z1_dot)
+        e7 * (-e1 + y1) + e8 * (-e4 + x1) + 2.0 * (z1_dot * z1_dot)
+        + 2.0 * ((e2 + x1_dot) * (e2 + x1_dot)) + 2.0 * ((e5 - y1_dot) * (e5 - y1_dot))
     )
     out[1] = (
-        psi_dot * (e11 * e6 - 2.0 * e2 * x2_dot + psi_dot * (e10 - e3 * (e2 + y2) - e7 * (e6 + x2)))
-        + x2_dot * (-e4 + 2.0 * x2_dot) + y2_dot * (e11 + e8) + 2.0 * (z2_dot * z2_dot)
+        -e7 * (e1 + y2) - e8 * (e4 + x2) + 2.0 * (z2_dot * z2_dot)
+        + 2.0 * ((e2 - x2_dot) * (e2 - x2_dot)) + 2.0 * ((e5 + y2_dot) * (e5 + y2_dot))
     )
-    out[2] = -e12 * psi_dot - e13 * psi_dot + psi_dot * (-e12 - e13 + psi_dot * (e1 * x1 - e5 * y1))
-    out[3] = -e14 * psi_dot - e15 * psi_dot + psi_dot * (-e14 - e15 + psi_dot * (e1 * x2 - e5 * y2))
+    out[2] = psi_dot * (e0 * psi_dot * x1 - e10 * y1_dot - e11 * y1 - e9 * x1_dot)
+    out[3] = psi_dot * (e0 * psi_dot * x2 - e10 * y2_dot - e11 * y2 - e9 * x2_dot)
 
 
 @njit(cache=True)
@@ -408,84 +395,83 @@ def energy(t, q, v, p):
     e0 = g * m_ball
     e1 = 0.5 * g * m_rod
     e2 = (psi_dot * psi_dot)
-    e3 = J_shaft + J_slider
-    e4 = 0.3333333333333333 * m_rod
-    e5 = (x1_dot * x1_dot) + (y1_dot * y1_dot) + (z1_dot * z1_dot)
-    e6 = 0.5 * m_ball
-    e7 = (x2_dot * x2_dot) + (y2_dot * y2_dot) + (z2_dot * z2_dot)
-    e8 = simdmath.sin(psi)
-    e9 = a * e8
-    e10 = e9 * psi_dot
-    e11 = 0.16666666666666666 * m_rod
-    e12 = simdmath.cos(psi)
-    e13 = a * e12
-    e14 = e13 * psi_dot
-    e15 = e13 * y1_dot
-    e16 = e9 * x1_dot
-    e17 = (e12 * e12)
-    e18 = (a * a)
-    e19 = e18 * e2
-    e20 = (e8 * e8)
-    e21 = e17 * e19 + e19 * e20
-    e22 = e9 * x2_dot
-    e23 = e13 * y2_dot
-    e24 = 0.5 * p10_ - s
-    e25 = e * e8
-    e26 = 0.5 * e9
-    e27 = e * e12
-    e28 = 0.5 * e13
-    e29 = 0.5 * K
-    e30 = 2.0 * e18 * psi_dot
-    e31 = e17 * e30 + e20 * e30
+    e3 = (x1_dot * x1_dot)
+    e4 = (y1_dot * y1_dot)
+    e5 = (z1_dot * z1_dot)
+    e6 = e3 + e4 + e5
+    e7 = 0.5 * m_ball
+    e8 = (x2_dot * x2_dot)
+    e9 = (y2_dot * y2_dot)
+    e10 = (z2_dot * z2_dot)
+    e11 = e10 + e8 + e9
+    e12 = 2.0 * e3 + 2.0 * e4 + 2.0 * e5
+    e13 = 2.0 * e10 + 2.0 * e8 + 2.0 * e9
+    e14 = simdmath.cos(psi)
+    e15 = a * psi_dot
+    e16 = e14 * e15
+    e17 = e16 * y1_dot
+    e18 = simdmath.sin(psi)
+    e19 = e15 * e18
+    e20 = e19 * x1_dot
+    e21 = (a * a) * e2
+    e22 = (e14 * e14) * e21
+    e23 = (e18 * e18) * e21
+    e24 = e22 + e23
+    e25 = 0.16666666666666666 * m_rod
+    e26 = e19 * x2_dot
+    e27 = e16 * y2_dot
+    e28 = 0.5 * p10_ - s
+    e29 = e * e18
+    e30 = 0.5 * a
+    e31 = e18 * e30
+    e32 = e * e14
+    e33 = e14 * e30
+    e34 = 0.5 * K
+    e35 = 2.0 * e22 + 2.0 * e23
     return (
-        e0 * z1 + e0 * z2 + e1 * (p10_ + z1) + e1 * (p10_ + z2)
-        - e11 * (e21 + e22 * psi_dot - e23 * psi_dot + e7)
-        - e11 * (e15 * psi_dot - e16 * psi_dot + e21 + e5) - 0.5 * e2 * e3
-        + e29
+        e0 * z1 + e0 * z2 + e1 * (p10_ + z1) + e1 * (p10_ + z2) - e11 * e7 + e12 * e7 + e13 * e7
+        + 0.5 * e2 * (J_shaft + J_slider) - e25 * (e11 + e24 + e26 - e27)
+        + e25 * (e12 + 2.0 * e17 - 2.0 * e20 + e35) + e25 * (e13 + 2.0 * e26 - 2.0 * e27 + e35)
+        - e25 * (e17 - e20 + e24 + e6)
+        + e34
           * (
                 (
                     -l0
                     + math.sqrt(
-                          ((e24 + 0.5 * z1) * (e24 + 0.5 * z1))
-                          + ((-e25 + e26 + 0.5 * y1) * (-e25 + e26 + 0.5 * y1))
-                          + ((-e27 + e28 + 0.5 * x1) * (-e27 + e28 + 0.5 * x1))
+                          ((e28 + 0.5 * z1) * (e28 + 0.5 * z1))
+                          + ((-e29 + e31 + 0.5 * y1) * (-e29 + e31 + 0.5 * y1))
+                          + ((-e32 + e33 + 0.5 * x1) * (-e32 + e33 + 0.5 * x1))
                       )
                 )
                  * (
                     -l0
                     + math.sqrt(
-                          ((e24 + 0.5 * z1) * (e24 + 0.5 * z1))
-                          + ((-e25 + e26 + 0.5 * y1) * (-e25 + e26 + 0.5 * y1))
-                          + ((-e27 + e28 + 0.5 * x1) * (-e27 + e28 + 0.5 * x1))
+                          ((e28 + 0.5 * z1) * (e28 + 0.5 * z1))
+                          + ((-e29 + e31 + 0.5 * y1) * (-e29 + e31 + 0.5 * y1))
+                          + ((-e32 + e33 + 0.5 * x1) * (-e32 + e33 + 0.5 * x1))
                       )
                 )
             )
-         + e29
+         + e34
         * (
               (
                   -l0
                   + math.sqrt(
-                        ((e24 + 0.5 * z2) * (e24 + 0.5 * z2))
-                        + ((e25 - e26 + 0.5 * y2) * (e25 - e26 + 0.5 * y2))
-                        + ((e27 - e28 + 0.5 * x2) * (e27 - e28 + 0.5 * x2))
+                        ((e28 + 0.5 * z2) * (e28 + 0.5 * z2))
+                        + ((e29 - e31 + 0.5 * y2) * (e29 - e31 + 0.5 * y2))
+                        + ((e32 - e33 + 0.5 * x2) * (e32 - e33 + 0.5 * x2))
                     )
               )
                * (
                   -l0
                   + math.sqrt(
-                        ((e24 + 0.5 * z2) * (e24 + 0.5 * z2))
-                        + ((e25 - e26 + 0.5 * y2) * (e25 - e26 + 0.5 * y2))
-                        + ((e27 - e28 + 0.5 * x2) * (e27 - e28 + 0.5 * x2))
+                        ((e28 + 0.5 * z2) * (e28 + 0.5 * z2))
+                        + ((e29 - e31 + 0.5 * y2) * (e29 - e31 + 0.5 * y2))
+                        + ((e32 - e33 + 0.5 * x2) * (e32 - e33 + 0.5 * x2))
                     )
               )
           )
-         - e5 * e6 - e6 * e7 + g * m_slider * s + 0.5 * m_slider * (s_dot * s_dot)
-        + psi_dot * (e11 * (e15 - e16 + e31) + e11 * (e22 - e23 + e31) + e3 * psi_dot)
-        + x1_dot * (e11 * (-e10 + 2.0 * x1_dot) + m_ball * x1_dot)
-        + x2_dot * (e11 * (e10 + 2.0 * x2_dot) + m_ball * x2_dot)
-        + y1_dot * (e11 * (e14 + 2.0 * y1_dot) + m_ball * y1_dot)
-        + y2_dot * (e11 * (-e14 + 2.0 * y2_dot) + m_ball * y2_dot)
-        + z1_dot * (e4 * z1_dot + m_ball * z1_dot) + z2_dot * (e4 * z2_dot + m_ball * z2_dot)
+         - e6 * e7 + g * m_slider * s + 0.5 * m_slider * (s_dot * s_dot)
     )
 
 

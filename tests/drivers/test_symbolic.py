@@ -229,6 +229,77 @@ def test_nonconservative_forces_enter_gamma():
     assert sp.simplify(gamma[1] - (sp.Symbol("g") + c * yd)) == 0
 
 
+@pytest.mark.parametrize("expand", [True, False])
+def test_derived_pieces_match_their_definitions(expand):
+    """γ, f_accel and the energy, derived as derivatives along the motion, against their
+    definitions written out with full Jacobians: γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q,
+    f_accel = (∂ḟ/∂q) v + ∂ḟ/∂t with ḟ = f_q v + f_t, and E = vᵀ ∂L/∂v − L.  The system
+    has time in its mass, its velocity terms and its constraint, and a non-conservative
+    force, so every term of each definition is there; compared at random states."""
+    (x, y, z), (xd, yd, zd) = coordinates("x y z")
+    a, b, c, g = sp.symbols("a b c g")
+    tt = stabdae.symbolic.t
+    lagrangian = ((1 + a * sp.sin(tt) * x**2) * xd**2 / 2 + (yd**2 + zd**2) / 2
+                  + b * sp.cos(tt) * (x * yd - y * xd) * sp.exp(z) - g * z)  # fmt: skip
+    holonomic = [sp.sqrt(x**2 + y**2 + 1) * sp.cos(z + tt) - 1,
+                 x * y * z - c * sp.sin(2 * tt)]  # fmt: skip
+    system = System("along", q=[x, y, z], v=[xd, yd, zd], lagrangian=lagrangian,
+                    holonomic=holonomic, forces=[-c * xd * yd, 0, sp.sin(tt) * zd],
+                    params={a: 0.3, b: 0.7, c: 0.2, g: 9.81}, reference_state=[0] * 6,
+                    simplify=False, expand=expand)  # fmt: skip
+    q, v = sp.Matrix(system.q), sp.Matrix(system.v)
+    p_v = sp.Matrix([lagrangian.diff(s) for s in v])
+    f = sp.Matrix(holonomic)
+    f_dot = f.jacobian(q) * v + f.diff(tt)
+    definition = {
+        "forces": p_v.jacobian(q) * v + p_v.diff(tt) - sp.Matrix([lagrangian.diff(s) for s in q])
+        - system.Q,
+        "f_accel": f_dot.jacobian(q) * v + f_dot.diff(tt),
+        "energy": sp.Matrix([(v.T * p_v)[0, 0] - lagrangian]),
+    }
+    derived = system.derive()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        point = dict(zip([*q, *v, tt], rng.uniform(-1.0, 1.0, 7)))
+        point.update(system.params)
+        for piece, expected in definition.items():
+            got = sp.Matrix([derived[piece]]) if piece == "energy" else derived[piece]
+            for e_got, e_want in zip(got, expected):
+                want = float(e_want.evalf(subs=point))
+                assert abs(float(e_got.evalf(subs=point)) - want) <= 1e-12 * max(1.0, abs(want))
+
+
+def test_kept_chain_f_accel_grows_linearly_with_the_links():
+    """The tip constraint of a chain of N rods in its joint angles nests N sines and
+    cosines in a square root; its second derivative along the motion needs a fixed number
+    of operations per link.  Built from the full Jacobian (n partial derivatives, each
+    dotted with v) it grew as N² (129, 264, 549 operations at 3, 5, 8 links)."""
+    chain = load_file(ROOT / "studies" / "bench_generate.py", "stabdae_bench_generate").minimal
+    ops = {}
+    for links in (3, 8):
+        system = chain(links, simplify=False, expand=False)
+        system.source()
+        ops[links] = system.operations["f_accel"]
+    assert ops[8] <= ops[3] * 8 / 3, ops
+
+
+def test_entries_that_cancel_are_zero_and_parameters_are_not_taken_at_their_defaults():
+    """Kept unexpanded, ∂/∂a of (1 + sin 2a − 2 sin a cos a)·ḃ is a sum that cancels only
+    to roundoff; the derivation finds it zero (a structural zero the sparsity then sees at
+    every state).  An entry that is zero only at a parameter's default value (c = 0)
+    stays."""
+    (a, b), (ad, bd) = coordinates("a b")
+    c = sp.Symbol("c")
+    one = 1 + sp.sin(2 * a) - 2 * sp.sin(a) * sp.cos(a)
+    system = System("cancel", q=[a, b], v=[ad, bd], lagrangian=(ad**2 + bd**2) / 2,
+                    nonholonomic=[one * bd + c * b * ad],
+                    params={c: 0.0}, reference_state=[0] * 4, simplify=False,
+                    expand=False)  # fmt: skip
+    h_q, h_v = system.derive()["h_q"], system.derive()["h_v"]
+    assert h_q[0, 0] == 0 and h_q[0, 1] != 0  # c·ȧ stays though c = 0 by default
+    assert h_v[0, 0] != 0 and h_v[0, 1] != 0
+
+
 def test_cli_generate(tmp_path, capsys):
     out = tmp_path / "sph.py"
     code = main(["generate", str(SPECS / "spherical_pendulum.py"), "-o", str(out)])
@@ -278,8 +349,8 @@ def test_unexpanded_derivation_is_the_same_model_in_fewer_operations(tmp_path):
     """``expand=False`` keeps the product and chain rules' trees and lets common
     subexpressions share them: the same model (every piece within 1e-12 at random
     states, and it passes check) in well under half the operations of the expanded one
-    (measured: 478 against 1361 at 3 links; at 5 links 1006 against 7222, derived in
-    0.7 s against 129 s).  ``stabdae generate`` reports the count."""
+    (measured: 356 against 1379 at 3 links; at 5 links 654 against 7309, derived in
+    0.7 s against 96 s).  ``stabdae generate`` reports the count."""
     # a chain of rods in its joint angles whose tip is held at a fixed distance from a
     # pin: a constraint that nests the angles in a square root of squared sums
     chain = load_file(ROOT / "studies" / "bench_generate.py", "stabdae_bench_generate").minimal
