@@ -1,7 +1,7 @@
 """Deriving a model from its Lagrangian: minimal against redundant coordinates, expanded
 against kept as the product and chain rules build it.
 
-    python studies/bench_generate.py [--links 3 5 8] [--expanded-up-to 5]
+    python studies/bench_generate.py [--links 3 5 8] [--expanded-up-to 5] [--specs bicycle ...]
 
 The system: a chain of N rods whose tip is held at a fixed distance from a pin.  In
 minimal coordinates (the N joint angles, one constraint: the tip's distance, a square
@@ -10,6 +10,8 @@ and ``expand=False``; in redundant coordinates (the N joints' x and y, N rod con
 and the tip's, all quadratic).  For each: the seconds to derive and to write the code,
 and the operations of the generated functions after common subexpressions
 (``System.operations``).  Expanded derivations grow fast: keep ``--expanded-up-to`` small.
+``--specs`` measures specs of ``kernels/specs/`` as they are written (the Whipple bicycle
+in 8 minimal and in 12 redundant coordinates: ``--specs bicycle bicycle_redundant``).
 """
 
 from __future__ import annotations
@@ -17,10 +19,13 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from pathlib import Path
 
 import sympy as sp
 
-from stabdae.symbolic import System, coordinates
+from stabdae.symbolic import System, coordinates, load_spec
+
+SPECS = Path(__file__).resolve().parent.parent / "kernels" / "specs"
 
 
 def _angles(links):
@@ -73,7 +78,7 @@ def measure(label: str, system: System) -> None:
     system.source()
     written = time.perf_counter()
     ops = system.operations
-    print(f"| {label} | {system.n} | {system.m} | {derived - start:.2f} | "
+    print(f"| {label} | {system.n} | {system.m + system.k} | {derived - start:.2f} | "
           f"{written - derived:.2f} | {sum(ops.values())} | {ops.get('f_accel')} | "
           f"{ops.get('forces')} |", flush=True)  # fmt: skip
 
@@ -83,14 +88,18 @@ def main(argv=None) -> int:
     ap.add_argument("--links", type=int, nargs="+", default=[3, 5, 8])
     ap.add_argument("--expanded-up-to", type=int, default=5,
                     help="largest chain derived expanded (minimal coordinates)")
+    ap.add_argument("--specs", nargs="*", default=[], metavar="NAME",
+                    help="specs of kernels/specs to measure as written")
     args = ap.parse_args(argv)
-    print("| system | n | m | derive s | code s | operations | f_accel | forces |")
+    print("| system | n | m + k | derive s | code s | operations | f_accel | forces |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
     for links in args.links:
         measure(f"{links} links, redundant", redundant(links, simplify=False))
         measure(f"{links} links, minimal, kept", minimal(links, simplify=False, expand=False))
         if links <= args.expanded_up_to:
             measure(f"{links} links, minimal, expanded", minimal(links, simplify=False))
+    for name in args.specs:
+        measure(f"`{name}` spec", load_spec(SPECS / f"{name}.py"))
     return 0
 
 
