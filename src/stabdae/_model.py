@@ -136,9 +136,15 @@ class Model:
 
     Notes
     -----
-    At construction every supplied function is called once at the reference state, first
-    as plain Python (so that an out-of-bounds write raises instead of corrupting memory)
-    and then compiled.  Derivatives are not checked here; use :meth:`check`.
+    At construction every supplied function is called at the reference state as plain
+    Python (so that an out-of-bounds write raises instead of corrupting memory; a function
+    that does not run as Python is compiled with bounds checks instead), and the sparsity
+    patterns are found the same way.  Numba compiles each function when it is first
+    needed: by :meth:`evaluate` and :meth:`check` (a function that does not compile is
+    named there) and inside the kernels, which compile their own copies of the pieces, so
+    that loading a model of thousands of operations takes a second, not the minutes its
+    functions would take to compile twice.  Derivatives are not checked here; use
+    :meth:`check`.
     """
 
     def __init__(
@@ -361,12 +367,17 @@ class Model:
         Absent optional pieces evaluate to their neutral value (identity mass, zero
         ``f_t``/``h_t``).  Not for hot loops.
         """
+        return self._value(piece, t, x, p, python=False)
+
+    def _value(self, piece: str, t: float, x: np.ndarray, p, python: bool):
+        """:meth:`evaluate`, compiled or (``python=True``, at construction) as Python."""
         p = self.default_params() if p is None else p
         q, v = np.ascontiguousarray(x[: self.n]), np.ascontiguousarray(x[self.n :])
+        call = _call_python if python else self._call_named
         if piece == "energy":
             if self.energy is None:
                 raise ModelError(f"Model {self.name!r} has no energy function")
-            return float(_call_compiled(self.energy, float(t), q, v, p))
+            return float(call("energy", self.energy, float(t), q, v, p))
         if piece not in _PIECES:
             raise ModelError(f"unknown model piece {piece!r}; pieces: {list(_PIECES)}")
         pattern, shape_of, _ = _PIECES[piece]
@@ -378,21 +389,39 @@ class Model:
             return np.zeros(shape)
         out = np.zeros(shape)
         args = (float(t), q, p) if pattern == "tqp" else (float(t), q, v, p)
-        _call_compiled(fn, *args, out)
+        call(piece, fn, *args, out)
         return out
+
+    def _call_named(self, piece: str, fn, *args):
+        """The compiled ``fn(*args)``; a function numba cannot compile is named."""
+        from numba.core.errors import NumbaError
+
+        try:
+            return _call_compiled(fn, *args)
+        except NumbaError as exc:
+            shapes = ", ".join(f"{np.shape(a)}" for a in args if isinstance(a, np.ndarray))
+            raise ModelError(
+                f"Model {self.name!r}: {_call_signature(piece)} failed to compile with "
+                f"float64 scalars and C-contiguous float64 arrays (of shapes {shapes}): "
+                f"{_first_lines(exc)}"
+            ) from exc
 
     def residual(self, x: np.ndarray, t: float | None = None, p: np.ndarray | None = None):
         """The residual ``g = (f, ḟ, h)`` of (3.2) at state ``x``, shape (2m + k,)."""
+        return self._residual(x, t, p, python=False)
+
+    def _residual(self, x, t, p, python: bool) -> np.ndarray:
         t = self.t0 if t is None else t
         v = np.asarray(x, dtype=np.float64)[self.n :]
         parts = []
+
+        def value(piece):
+            return self._value(piece, t, x, p, python)
+
         if self.m:
-            parts += [
-                self.evaluate("f", t, x, p),
-                self.evaluate("f_q", t, x, p) @ v + self.evaluate("f_t", t, x, p),
-            ]
+            parts += [value("f"), value("f_q") @ v + value("f_t")]
         if self.k:
-            parts.append(self.evaluate("h", t, x, p))
+            parts.append(value("h"))
         return np.concatenate(parts)
 
     def consistent_state(self, fixed=None, *, guess=None, params=None, t=None,
@@ -544,7 +573,7 @@ class Model:
     def _probe_all(self, x: np.ndarray, p: np.ndarray) -> dict:
         q, v = x[: self.n].copy(), x[self.n :].copy()
         t = self.t0
-        outputs = self._probe_at(t, x, p)
+        outputs = self._probe_at(t, x, p, compiled=False)
         if "mass" in outputs:
             self._check_symmetric(outputs["mass"])
         if self.energy is not None:
@@ -552,7 +581,8 @@ class Model:
         if self.outputs is not None:
             probe_output(f"Model {self.name!r}: outputs(t, q, v, p, out)", self.outputs,
                          (float(t), np.ascontiguousarray(q), np.ascontiguousarray(v), p),
-                         (len(self.output_names),), "one per output_names")  # fmt: skip
+                         (len(self.output_names),), "one per output_names",
+                         compiled=False)  # fmt: skip
         return outputs
 
     def derived(self, x, t=None, params=None) -> np.ndarray:
@@ -625,7 +655,7 @@ class Model:
             seen = self._detect_states(x_ref)
             for t, x in zip(*seen):
                 with np.errstate(all="ignore"):
-                    value = self.evaluate(piece, t, x, p)
+                    value = self._value(piece, t, x, p, python=True)
                 outside = (value != 0) & ~pattern
                 if outside.any():
                     i = tuple(int(j) for j in np.argwhere(outside)[0])
@@ -652,7 +682,7 @@ class Model:
             pattern = None
             for x, t in zip(xs, ts):
                 with np.errstate(all="ignore"):
-                    nz = self.evaluate(piece, t, x, p) != 0  # NaN counts as non-zero
+                    nz = self._value(piece, t, x, p, python=True) != 0  # NaN: non-zero
                 pattern = nz if pattern is None else pattern | nz
             patterns[piece] = pattern
         return patterns
@@ -704,10 +734,11 @@ class Model:
                 h.update(f"{piece}{pat.shape}".encode() + np.packbits(pat).tobytes())
         return h.hexdigest()[:16]
 
-    def _probe_at(self, t: float, x: np.ndarray, p: np.ndarray, where: str = "") -> dict:
+    def _probe_at(self, t: float, x: np.ndarray, p: np.ndarray, where: str = "",
+                  compiled: bool = True) -> dict:  # fmt: skip
         """Run every piece at ``(t, x)`` through :func:`probe_output` (first as Python, with
-        NumPy's bounds checks); returns the outputs by piece.  ``where`` is added to the
-        messages ("at check state 3")."""
+        NumPy's bounds checks, then compiled unless ``compiled=False``); returns the
+        outputs by piece.  ``where`` is added to the messages ("at check state 3")."""
         q, v = np.ascontiguousarray(x[: self.n]), np.ascontiguousarray(x[self.n :])
         outputs = {}
         for piece, fn in self.functions.items():
@@ -716,7 +747,7 @@ class Model:
             outputs[piece] = probe_output(
                 f"Model {self.name!r}: {_call_signature(piece)}{where}",
                 fn, args, shape_of(self.n, self.m, self.k),
-                f"{governs} from n={self.n}, m={self.m}, k={self.k}",
+                f"{governs} from n={self.n}, m={self.m}, k={self.k}", compiled=compiled,
             )  # fmt: skip
         return outputs
 
@@ -736,7 +767,7 @@ class Model:
 
     def _probe_energy(self, t, q, v, p) -> None:
         try:
-            e = _call_compiled(self.energy, t, q, v, p)
+            e = _call_python("energy", self.energy, t, q, v, p)
         except Exception as exc:
             raise ModelError(
                 f"Model {self.name!r}: energy(t, q, v, p) failed at the reference state: "
@@ -753,7 +784,7 @@ class Model:
             )
 
     def _check_consistent(self, x: np.ndarray, p: np.ndarray) -> None:
-        g = self.residual(x, self.t0, p)
+        g = self._residual(x, self.t0, p, python=True)
         scale = max(1.0, float(np.max(np.abs(x))))
         tol = 1e-9 * scale
         if np.max(np.abs(g)) > tol:
@@ -768,7 +799,8 @@ class Model:
         """When the constraints change with t but the model declares no f_t / h_t: the
         likely cause of an inconsistent ḟ or h, named."""
         dt = 1e-6 * max(1.0, abs(self.t0))
-        moved = self.residual(x, self.t0 + dt, p) - self.residual(x, self.t0, p)
+        moved = (self._residual(x, self.t0 + dt, p, python=True)
+                 - self._residual(x, self.t0, p, python=True))  # fmt: skip
         hints = []
         if self.m and "f_t" not in self.functions and np.abs(moved[: self.m]).max() > 0:
             hints.append("f changes with t but the model gives no f_t(t, q, p, out) (∂f/∂t, "
@@ -780,14 +812,16 @@ class Model:
 
 # --------------------------------------------------------------------- helpers
 
-def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs: str) -> np.ndarray:
-    """Call ``fn(*args, out)`` once as Python and once compiled; check shape and finiteness.
+def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs: str,
+                 compiled: bool = True) -> np.ndarray:  # fmt: skip
+    """Call ``fn(*args, out)`` once as Python and (``compiled``) once compiled; check shape
+    and finiteness.
 
     ``where`` names the function in messages ("Model 'x': f(t, q, p, out)"), ``governs``
     says which sizes fix ``shape``.  Running the Python version first means an
     out-of-bounds write raises ``IndexError`` instead of corrupting memory; the compiled
     call then compiles the function for the argument types the kernels use.
-    Returns the output of the compiled call.
+    Returns the output of the compiled call, or without it of the Python one.
     """
     out = np.full(shape, _UNWRITTEN)
     try:
@@ -817,15 +851,17 @@ def probe_output(where: str, fn: Dispatcher, args: tuple, shape: tuple, governs:
             f"{where} returned non-finite values at the reference state at entries "
             f"{_index_list(~np.isfinite(out))}: {out.tolist()}"
         )
-    compiled = np.zeros(shape)
+    if not compiled:
+        return out
+    result = np.zeros(shape)
     try:
-        _call_compiled(fn, *args, compiled)
+        _call_compiled(fn, *args, result)
     except Exception as exc:  # numba typing errors come in many classes
         raise ModelError(
             f"{where} failed to compile or run with float64 scalars and C-contiguous float64 "
             f"arrays (out of shape {shape}): {_first_lines(exc)}"
         ) from exc
-    return compiled
+    return result
 
 
 def _derived_loop_for(fn: Dispatcher):
@@ -839,6 +875,15 @@ def _derived_loop_for(fn: Dispatcher):
                 fn(T[i], X[i, :n].copy(), X[i, n:].copy(), p, out[i])
 
     return loop
+
+
+def _call_python(piece: str, fn: Dispatcher, *args):
+    """``fn(*args)`` as plain Python; one that only runs compiled (numba-only features)
+    runs compiled."""
+    try:
+        return python_function(fn)(*args)
+    except Exception:
+        return _call_compiled(fn, *args)
 
 
 def _call_compiled(fn: Dispatcher, *args):

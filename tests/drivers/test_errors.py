@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import fractions
+
 import numpy as np
 import pytest
 from numba import njit
@@ -124,6 +126,40 @@ def test_plain_python_function():
 def test_compile_failure_is_named():
     with pytest.raises(stabdae.ModelError, match=r"forces\(t, q, v, p, out\) .*failed"):
         build(forces=forces_bad_types)
+
+
+@njit
+def forces_python_only(t, q, v, p, out):
+    out[0] = 0.0
+    out[1] = float(fractions.Fraction(1, 1))  # runs as Python; numba cannot type it
+
+
+def test_loading_a_model_compiles_none_of_its_functions():
+    """Construction runs the pieces as Python (the kernels compile their own copies):
+    fresh dispatchers have no compiled signature after it, and one after evaluate."""
+    base = build()
+    fresh = {piece: njit(fn.py_func) for piece, fn in base.functions.items()}
+    model = build(**fresh)
+    assert all(fn.signatures == [] for fn in model.functions.values())
+    assert model.evaluate("forces", 0.0, model.reference_state()).shape == (2,)
+    assert len(model.functions["forces"].signatures) == 1
+    assert model.functions["f_q"].signatures == []
+
+
+def test_a_function_numba_cannot_compile_is_named_where_it_is_first_compiled():
+    """It runs as Python, so the model loads; evaluate, check and integrate then name it
+    (before, construction compiled every function and refused it there)."""
+    model = build(forces=forces_python_only)
+    x = model.reference_state()
+    with pytest.raises(stabdae.ModelError, match=r"forces\(t, q, v, p, out\) failed to "
+                                                 r"compile .*Fraction"):  # fmt: skip
+        model.evaluate("forces", 0.0, x)
+    with pytest.raises(stabdae.ModelError, match=r"forces\(t, q, v, p, out\) at check state "
+                                                 r"0 failed to compile"):  # fmt: skip
+        model.check()
+    with pytest.raises(stabdae.ModelError, match=r"integrate: a function of model 'broken' "
+                                                 r"raised TypingError"):  # fmt: skip
+        stabdae.integrate(model, x, stabdae.baumgarte(10.0, 1.0), "rk4", 1e-3, 0.01, 0.01)
 
 
 def test_missing_and_superfluous_pieces():
