@@ -326,14 +326,16 @@ class System:
     def _cancel(self, matrix: sp.Matrix, points: int = 3, digits: int = 50) -> sp.Matrix:
         """``matrix`` with its entries that are zero only after cancelling set to 0.
 
-        Expanded entries that cancel are already 0.  Kept as the derivative rules build
-        them, such an entry (a rolling wheel's slip, which does not depend on the frame's
-        pitch, differentiated by the pitch) would be computed to roundoff, and a model's
+        With ``expand=True`` the expansion has found the algebraic cancellations, and
+        nothing is tested.  Kept as the derivative rules build them, an entry that cancels
+        (a rolling wheel's slip, which does not depend on the frame's pitch,
+        differentiated by the pitch) would be computed to roundoff, and a model's
         structural zeros (its sparsity, which the kernels exploit) would then hold only at
         some states.  An entry is zero when it evaluates to less than 1e-30 in 50-digit
         arithmetic at ``points`` random states, times and parameters (each parameter within
-        20 % of its value): a polynomial identity test, which a non-zero entry passes only
-        on a set of measure zero."""
+        20 % of its value, or near 1 where it is 0): a randomized identity test, since an
+        analytic entry that is not identically zero vanishes only on a set of measure
+        zero.  Where an entry is undefined at a drawn state, nothing is set to zero."""
         if self.expand:
             return matrix
         where = [i for i, e in enumerate(matrix) if e != 0]
@@ -349,7 +351,10 @@ class System:
                 for value in self.params.values():
                     spread = 1.0 + 0.2 * rng.uniform(-1.0, 1.0)
                     values.append(mpmath.mpf(value * spread if value else spread))
-                got = evaluate(*values)
+                try:
+                    got = evaluate(*values)
+                except (ArithmeticError, ValueError, TypeError):
+                    return matrix  # a state where an entry is undefined: decide nothing
                 zero &= np.array([abs(g) < mpmath.mpf(10) ** -30 for g in got])
         if not zero.any():
             return matrix

@@ -323,7 +323,10 @@ IMPORT_PLAIN = textwrap.dedent(
     import sys
     sys.path.insert(0, sys.argv[1])
     import pendulum_cached
-    print(pendulum_cached.model.name, pendulum_cached.__name__)
+    model = pendulum_cached.model
+    for piece in model.functions:  # compiled when first called: the entries are used here
+        model.evaluate(piece, model.t0, model.reference_state())
+    print(model.name, pendulum_cached.__name__)
     """
 )
 LOAD = textwrap.dedent(
@@ -331,6 +334,8 @@ LOAD = textwrap.dedent(
     import sys
     import stabdae
     model = stabdae.load_model(sys.argv[1])
+    for piece in model.functions:
+        model.evaluate(piece, model.t0, model.reference_state())
     print(model.name, [k for k, m in sys.modules.items()
                        if not k.startswith("__") and getattr(m, "model", None) is model])
     """
@@ -338,11 +343,11 @@ LOAD = textwrap.dedent(
 
 
 def test_a_cached_model_file_loads_and_imports_under_one_name(tmp_path):
-    """A model file whose functions are ``@njit(cache=True)``: numba's entries name the
-    module they were compiled in.  load_model gives the file the name a plain import does,
-    so a process that imports it and one that loads it share the entries both ways; an
-    entry made under another name (here: loaded with importlib under a made-up one) is
-    passed over, not an error."""
+    """A model file whose functions are ``@njit(cache=True)``: numba's entries (made when
+    a piece is first evaluated) name the module they were compiled in.  load_model gives
+    the file the name a plain import does, so a process that imports it and one that loads
+    it share the entries both ways; an entry made under another name (here: loaded with
+    importlib under a made-up one) is passed over, not an error."""
     model_file = tmp_path / "pendulum_cached.py"
     model_file.write_text((scene_dir() / "pendulum.py").read_text())
     assert "@njit(cache=True)" in model_file.read_text()
@@ -361,6 +366,8 @@ def test_a_cached_model_file_loads_and_imports_under_one_name(tmp_path):
         module = importlib.util.module_from_spec(spec)
         sys.modules["elsewhere_named"] = module
         spec.loader.exec_module(module)
+        for piece in module.model.functions:
+            module.model.evaluate(piece, 0.0, module.model.reference_state())
         print(module.model.name)
         """
     )
@@ -404,11 +411,13 @@ def test_bounds_checked_kernels_are_keyed_apart(monkeypatch):
 
 def test_a_damaged_numba_cache_entry_is_cleared_with_a_warning_that_names_it(tmp_path):
     """A model file's @njit(cache=True) functions with their numba cache entries
-    overwritten: the model loads, each damaged entry is named in one warning (not blamed
-    on the model), and the next process finds a sound cache again."""
+    overwritten: the model loads and evaluates, each damaged entry is named in one warning
+    (not blamed on the model), and the next process finds a sound cache again."""
     model_file = tmp_path / "pendulum_damaged.py"
     model_file.write_text((scene_dir() / "pendulum.py").read_text())
-    load = "import stabdae, sys; print(stabdae.load_model(sys.argv[1]).n)"
+    load = ("import stabdae, sys; m = stabdae.load_model(sys.argv[1])\n"
+            "for piece in m.functions: m.evaluate(piece, m.t0, m.reference_state())\n"
+            "print(m.n)")
     env = dict(os.environ, PYTHONPATH=str(SRC))
 
     def run():
