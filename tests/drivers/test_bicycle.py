@@ -93,3 +93,22 @@ def test_self_stable_speeds_follow_the_benchmark():
         lam = linearised_eigenvalues(model, speed)
         lam = lam[np.abs(lam) > 1e-3]
         assert (lam.real.max() < 0) == stable == (published_eigenvalues(speed).real.max() < 0)
+
+
+def test_consistent_state_from_a_lean_a_steer_and_three_rates():
+    """The use the spec's coordinates were chosen for: hold the lean, the steer, where the
+    bicycle is and the three free rates (roll, steer, rear wheel: 5 m/s); the pitch comes
+    from the front contact and the other five rates from the rolling constraints, to
+    roundoff.  Holding the pitch too contradicts the contact, which is named."""
+    model = load_scene("bicycle")
+    speed = 5.0
+    fixed = {"x": 0.0, "y": 0.0, "psi": 0.0, "phi": 0.1, "theta_R": 0.0, "delta": 0.2,
+             "theta_F": 0.0, "phi_dot": 0.3, "delta_dot": -0.5, "theta_R_dot": -speed / 0.3}
+    x = model.consistent_state(fixed)
+    names = list(model.state_names)
+    assert np.max(np.abs(model.residual(x))) <= 1e-13
+    assert all(x[names.index(k)] == value for k, value in fixed.items())
+    assert abs(x[names.index("theta")]) > 1e-3  # a leaned, steered bicycle pitches
+    assert x[names.index("psi_dot")] > 0.5  # steered right, it turns right
+    with pytest.raises(ValueError, match=r"f_0 = .* stay away from zero"):
+        model.consistent_state({**fixed, "theta": 0.0})
