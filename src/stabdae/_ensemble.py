@@ -353,8 +353,10 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
     return table
 
 
-def _build(run, times, x0, alpha0, out, status, referee, peak, roundoff) -> Table:
-    """The ensemble's table from its members' outputs."""
+def _build(run, times, x0, alpha0, out, status, referee, peak, roundoff, verdicts=None
+           ) -> Table:  # fmt: skip
+    """The ensemble's table from its members' outputs (``verdicts``: theirs, where
+    known)."""
     table = _table(
         run.model, run.p, run.law, run.scheme, run.bound, times, x0, alpha0, out.norms,
         run.traced, out.x_final, status, out.fail_step, out.e0, out.e1, run.epsilon,
@@ -364,7 +366,7 @@ def _build(run, times, x0, alpha0, out, status, referee, peak, roundoff) -> Tabl
              sampling_rtol=SAMPLING_RTOL,
              threads=run.threads if run.threads is not None else default_threads()),
         extra=run.mode.extra(out), overshoot_theory=peak, adaptive=run.adaptive,
-        roundoff=roundoff, referee=referee,
+        roundoff=roundoff, referee=referee, verdicts=verdicts,
     )  # fmt: skip
     if not run.states:
         del table.data["x0"], table.data["x_final"]
@@ -403,8 +405,9 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
             roundoff = _roundoff(run.model, out.x_final[:k], status[:k], run.p,
                                  float(times[-1]), gain, run.threads, run.sampled)  # fmt: skip
         x0, alpha0, out, status = _joined(parts, run.trace_row[:hi])
-        verdicts, _ = _measures.verdict(Record(out.meas.copy(), out.codes.copy()), status,
-                                        roundoff=roundoff, **referee)  # fmt: skip
+        judged = _measures.verdict(Record(out.meas.copy(), out.codes.copy()), status,
+                                   roundoff=roundoff, **referee)  # fmt: skip
+        verdicts = judged[0]
         unstable = int((verdicts == _measures.V_UNSTABLE).sum())
         stable = int((verdicts == _measures.V_STABLE).sum())
         decision = decide(plan, hi, unstable, hi - stable, last=j == len(looks) - 1)
@@ -415,7 +418,8 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
     traced = run.traced[run.traced < hi]
     out = out._replace(norms=out.norms[:traced.size])
     table = _build(replace(run, members=hi, traced=traced, trace_row=run.trace_row[:hi]),
-                   times, x0, alpha0, out, status, referee, peak, roundoff)  # fmt: skip
+                   times, x0, alpha0, out, status, referee, peak, roundoff,
+                   judged)  # fmt: skip
     for name, value in (("decision", np.int8(decision.verdict)),
                         ("decision_reason", np.int8(decision.reason)),
                         ("decision_low", decision.low), ("decision_high", decision.high),

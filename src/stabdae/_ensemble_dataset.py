@@ -83,8 +83,10 @@ def _warn_stopped(name: str, status) -> None:
 def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, traced,
                    x_final, status, fail_step, e0, e1, epsilon, meas, R, run,
                    extra=None, roundoff=0.0, overshoot_theory=math.nan,
-                   adaptive=False, referee=None) -> Table:  # fmt: skip
-    """The ensemble's :class:`Table` from what its kernel returned."""
+                   adaptive=False, referee=None, verdicts=None) -> Table:  # fmt: skip
+    """The ensemble's :class:`Table` from what its kernel returned (``verdicts``: the
+    members' verdicts and reasons where the caller has them already, from the same record
+    and referee)."""
     stopped = status != 0
     for name in ("beta_predicted", "beta", "gamma"):  # (not placed: measured on nothing)
         meas[name][stopped] = np.nan
@@ -93,7 +95,9 @@ def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, trace
     # γ bounds the transient β was fitted on: none without β (beta_reason says why)
     gamma = meas["gamma"]
     gamma[~np.isfinite(meas["beta"]) | ~np.isfinite(gamma)] = np.nan
-    verdicts, why = _measures.verdict(meas, status, roundoff=roundoff, **(referee or {}))
+    if verdicts is None:
+        verdicts = _measures.verdict(meas, status, roundoff=roundoff, **(referee or {}))
+    verdicts, why = verdicts
     cls = _measures.classify(meas, status, epsilon, verdicts)
     alpha_norm = np.max(np.abs(alpha0), axis=1)
     summary, radius_why = _measures.summaries(meas, verdicts, why, cls, alpha_norm, epsilon)

@@ -42,6 +42,7 @@ behind it.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -232,14 +233,14 @@ def roundoff_level(residual_rows, states, t: float) -> float:
     G = residual_rows(X.reshape(S * rows, n2), t).reshape(S, rows, -1)
     if t != 0.0:
         Gt = residual_rows(np.ascontiguousarray(X[:, -1]), t * (1.0 + h))
-    levels = []
-    for i in range(S):
-        terms = np.abs(G[i, 0:-1:2] - G[i, 1:-1:2]).sum(axis=0) / (2.0 * h)
-        if t != 0.0:
-            terms = terms + np.abs(Gt[i] - G[i, -1]) / h
-        if np.all(np.isfinite(terms)):
-            levels.append(float(terms.max()) if terms.size else 0.0)
-    return u * float(np.median(levels)) if levels else 0.0
+    terms = np.abs(G[:, 0:-1:2] - G[:, 1:-1:2]).sum(axis=1) / (2.0 * h)  # (S, components)
+    if t != 0.0:
+        terms = terms + np.abs(Gt - G[:, -1]) / h
+    finite = np.isfinite(terms).all(axis=1)
+    if not finite.any():
+        return 0.0
+    levels = terms[finite].max(axis=1) if terms.shape[1] else np.zeros(int(finite.sum()))
+    return u * float(np.median(levels))
 
 
 def wilson(successes: int, n: int) -> tuple[float, float]:
@@ -267,12 +268,19 @@ def median_interval(values, level: float = 0.95) -> tuple[float, float, float, f
     if n == 0:
         return math.nan, math.nan, math.nan, math.nan
     med = float(np.median(v))
+    k, coverage = _median_rank(n, float(level))
+    return med, float(v[k - 1]), float(v[n - k]), coverage
+
+
+@functools.lru_cache(maxsize=1024)
+def _median_rank(n: int, level: float) -> tuple[int, float]:
+    """The rank ``r`` of :func:`median_interval` for ``n`` values and its coverage (they
+    depend on ``n`` and ``level`` only: a study asks for the same few again and again)."""
     r = np.arange(1, n // 2 + 1)
     cover = 1.0 - 2.0 * stats.binom.cdf(r - 1, n, 0.5)
     ok = np.flatnonzero(cover >= level)
     k = int(r[ok[-1]]) if ok.size else 1
-    coverage = float(1.0 - 2.0 * stats.binom.cdf(k - 1, n, 0.5)) if n > 1 else 0.0
-    return med, float(v[k - 1]), float(v[n - k]), coverage
+    return k, float(1.0 - 2.0 * stats.binom.cdf(k - 1, n, 0.5)) if n > 1 else 0.0
 
 
 def stability_radius(alpha_norm, stable, decided) -> tuple[float, float, float, int]:

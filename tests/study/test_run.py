@@ -368,6 +368,53 @@ def test_the_store_gives_back_every_table_as_it_was(tmp_path):
     assert type(again.tables[2].attrs["only_here"]) is np.float32
 
 
+def test_the_store_gives_back_tables_of_different_member_counts(tmp_path):
+    """Grid points decided after different numbers of members share a chunk: each
+    variable's tables of different shapes come back each with its own shape and values."""
+    from stabdae.study.run import run_point
+    from stabdae.study.spec import load_study
+    from stabdae.study.store import Manifest, Store
+
+    tables = {}
+    for i, members in enumerate((16, 48, 32)):
+        (tmp_path / str(i)).mkdir()
+        study = load_study(study_file(tmp_path / str(i), members=members, t_end=0.2,
+                                      omegas="5.0"))  # fmt: skip
+        tables[i] = run_point(study, next(iter(study.points()))[1])
+    assert len({t.data["alpha0"][1].shape for t in tables.values()}) == 3
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    store = Store(Manifest(parts, "key", "study"))
+    for i, table in tables.items():
+        store.add(i, table)
+    store.flush()
+    again = Store(Manifest.read(parts))
+    again.resume(len(tables), log=lambda *a: pytest.fail(str(a)))
+    for i, table in tables.items():
+        xr.testing.assert_identical(again.tables[i].to_dataset(), table.to_dataset())
+
+
+def test_a_dataset_that_cannot_be_written_leaves_every_point_to_resume(tmp_path, monkeypatch):
+    """The last grid points are kept in memory until the dataset is written; when that
+    write fails they go to the store, and the run again computes none of them."""
+    import stabdae.study.run as runner
+
+    study = study_file(tmp_path, members=16, t_end=0.2, omegas="5.0")
+
+    def full_disk(ds, path, **kwargs):
+        raise OSError(f"could not write {path}: no space left")
+
+    monkeypatch.setattr(runner, "write_netcdf", full_disk)
+    with pytest.raises(OSError, match="no space left"):
+        run_study(study, progress=False, log=lambda *a: None)
+    assert recorded(tmp_path / "out" / "study.nc.parts") == 6
+    monkeypatch.setattr(runner, "write_netcdf", write_netcdf)
+    monkeypatch.setattr(runner, "run_point", lambda *a, **k: pytest.fail("computed again"))
+    said = []
+    run_study(study, progress=False, log=said.append)
+    assert "resuming: 6 of 6 grid points already done" in said
+
+
 def test_force_never_removes_what_stabdae_did_not_write(tmp_path):
     """A folder at OUTPUT.parts that no stabdae run wrote (no manifest) is refused, with
     and without --force, and left as it was; the parts of another study are discarded by

@@ -41,11 +41,12 @@ def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=(),
     dims = list(ds[columns[0]].dims)
     flat = ds[columns].stack(point=dims) if dims else ds[columns].expand_dims(point=[0])
     head = [d.split(".", 1)[-1] for d in dims] + [short.get(c, c) for c in columns]
-    rows = []
+    values = {k: flat[k].values for k in [*dims, *columns]}  # (xarray's indexing per cell
+    rows = []                                                 # was most of the table's time)
     for i in range(flat.sizes["point"]):
-        row = [f"{float(flat[d].values[i]):.4g}" for d in dims]
+        row = [f"{float(values[d][i]):.4g}" for d in dims]
         for c in columns:
-            v = float(flat[c].values[i])
+            v = float(values[c][i])
             if c in flags:
                 row.append("yes" if v == 1 else "no")
             elif c in codes:
@@ -117,23 +118,26 @@ def unstable_below_one(ds: xr.Dataset) -> str:
               + (["status"] if "status" in ds else [])]
     flat = flat.stack(point=dims) if dims else flat.expand_dims(point=[0])
     lines, singular = [], False
+    # every variable's values with the point first, once (not xarray's indexing per point)
+    arrays = {k: flat[k].transpose("point", ...).values for k in flat.variables
+              if k in flat.data_vars or k in dims}  # fmt: skip
     for i in range(flat.sizes["point"]):
-        rho = float(flat.spectral_radius.values[i])
-        verdict = flat.verdict.isel(point=i).values
+        rho = float(arrays["spectral_radius"][i])
+        verdict = arrays["verdict"][i]
         unstable = verdict == int(Verdict.UNSTABLE)
         if not (rho < 1.0) or not unstable.any():
             continue
-        where = ", ".join(f"{d.split('.', 1)[-1]} = {float(flat[d].values[i]):.4g}"
+        where = ", ".join(f"{d.split('.', 1)[-1]} = {float(arrays[d][i]):.4g}"
                           for d in dims)  # fmt: skip
-        reasons, counts = np.unique(flat.verdict_reason.isel(point=i).values[unstable],
+        reasons, counts = np.unique(arrays["verdict_reason"][i][unstable],
                                     return_counts=True)  # fmt: skip
         why = [f"{c} {VerdictReason(int(r)).message.split(':')[0]}"
                for r, c in zip(reasons, counts)]  # fmt: skip
         ran = verdict.size
         if "status" in flat:  # (a grid point run until decided: its own members only)
-            status = flat.status.isel(point=i).values
+            status = arrays["status"][i]
             ran = int((status != int(Status.NOT_NEEDED)).sum())
-            blew = status[unstable & (flat.verdict_reason.isel(point=i).values
+            blew = status[unstable & (arrays["verdict_reason"][i]
                                       == int(VerdictReason.BLEW_UP))]  # fmt: skip
             if blew.size:  # how they stopped: a singular S is not the scheme's remainder
                 how, many = np.unique(blew, return_counts=True)

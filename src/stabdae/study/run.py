@@ -24,6 +24,7 @@ import time
 import warnings
 from pathlib import Path
 
+import netCDF4
 import numpy as np
 import xarray as xr
 
@@ -35,6 +36,7 @@ from .._loading import local_imports
 from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
 from ..engine.cache import function_fingerprint, library_fingerprint
+from ..engine.crash import guard
 from .report import summary
 from .spec import Study, StudyError, load_study, members_text, most_members
 from .store import Manifest, Store, clear, stack
@@ -69,7 +71,9 @@ def run_point(study: Study, values: dict, threads=None, progress=None) -> Table:
     ens = study.ensemble
     if study.search is not None:
         return search_point(study, s, threads, progress)
-    with warnings.catch_warnings():  # stopped members: the study's summary counts them
+    # stopped members: the study's summary counts them; one crash guard for the point's
+    # kernels (each kernel call's own, inside it, then costs nothing)
+    with warnings.catch_warnings(), guard("ensemble"):
         warnings.simplefilter("ignore", IntegrationWarning)
         table = ensemble_table(study.model, s["law"], s["scheme"], s["tau"], s["t_end"],
                                members=ens["members"], radius=tuple(ens["radius"]),
@@ -142,9 +146,9 @@ def output_path(study: Study, output=None) -> Path:
 
 
 def _is_stabdae_dataset(path: Path) -> bool:
-    try:
-        with xr.open_dataset(path) as ds:
-            return "stabdae_version" in ds.attrs
+    try:  # the global attributes' names only (xarray would decode every variable's)
+        with netCDF4.Dataset(path) as nc:
+            return "stabdae_version" in nc.ncattrs()
     except Exception:  # not NetCDF, or unreadable
         return False
 
@@ -270,6 +274,7 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
         store.add(i, table)
         bar.point_done()
 
+    finished = False
     try:
         if workers or scheduler:
             _run_dask(study, todo, done, workers, scheduler)
@@ -277,14 +282,22 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
             for i, values in todo:
                 report = bar.note if study.search is not None else bar.members
                 done(i, run_point(study, values, threads=threads, progress=report))
+        finished = True
     finally:  # the points done are written whatever stopped the run (a kill aside)
         bar.close()
+        if not finished:
+            store.flush()
+    try:
+        ds = combine(study, [store.tables[i] for i in range(len(points))])
+        if not study.setup()["law"].is_constant and study.search is None:
+            ds = _with_path_theory(study, ds)
+        ds.attrs["wall_run_s"] = time.perf_counter() - start
+        write_netcdf(ds, out)
+    except BaseException:
+        # the last points go to the store only when the dataset could not be written
+        # (a full disk, Ctrl-C): a run again resumes from them
         store.flush()
-    ds = combine(study, [store.tables[i] for i in range(len(points))])
-    if not study.setup()["law"].is_constant and study.search is None:
-        ds = _with_path_theory(study, ds)
-    ds.attrs["wall_run_s"] = time.perf_counter() - start
-    write_netcdf(ds, out)
+        raise
     clear(parts)
     log(summary(ds))
     wall = time.perf_counter() - start

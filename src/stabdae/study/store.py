@@ -11,7 +11,9 @@ Here only that process writes: the workers return their tables, and a chunk is w
 at most every :data:`FLUSH_SECONDS` (and when the run stops, for any reason but a kill)
 with ``numpy.savez``, atomically (a temporary file renamed into place), its SHA-256 and
 grid points recorded in the manifest (``study.json``), which is itself replaced
-atomically.  A kill loses at most the grid points since the last chunk; a chunk whose
+atomically.  When every grid point is done, the last of them go to the chunks only if
+the dataset cannot be written (its write is the one that matters then).  A kill loses
+at most the grid points since the last chunk; a chunk whose
 bytes differ from the recorded checksum, or that cannot be read, is computed again.
 """
 
@@ -20,6 +22,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
 import os
 import time
 from pathlib import Path
@@ -186,11 +189,14 @@ def _sha256(data: bytes) -> str:
 def _pack(tables: dict[int, Table], fingerprint: str) -> dict:
     """The arrays of a chunk: each variable's (``d/<name>``) and coordinate's
     (``c/<name>``) values of all its tables stacked along a first axis (one array per
-    name: ``numpy.savez`` costs about 0.1 ms per array), or per table (``<k>/d/<name>``,
-    ``k`` the table's place in the chunk) where their shapes or types differ; and
+    name: ``numpy.savez`` costs about 0.1 ms per array); where their shapes differ, one
+    flat array of them all (``r/d/<name>``) and each table's shape in ``meta``; per
+    table (``<k>/d/<name>``, ``k`` the table's place in the chunk) where their types
+    differ; and
     ``meta``: the run key, the grid points and, per table, the dimensions and attributes
     (JSON, as bytes)."""
-    arrays, meta = {}, {"fingerprint": fingerprint, "points": list(tables), "tables": []}
+    arrays = {}
+    meta = {"fingerprint": fingerprint, "points": list(tables), "tables": [], "shapes": {}}
     group = list(tables.values())
     for kind, items in (("d", lambda t: {k: v[1] for k, v in t.data.items()}),
                         ("c", lambda t: {k: v.values for k, v in t.coords.items()})):
@@ -199,8 +205,14 @@ def _pack(tables: dict[int, Table], fingerprint: str) -> dict:
             for name, values in items(table).items():
                 columns.setdefault(name, []).append(_plain(values))
         for name, column in columns.items():
-            if len(column) == len(group) and len({(a.shape, a.dtype.str) for a in column}) == 1:
+            whole = len(column) == len(group)
+            if whole and len({(a.shape, a.dtype.str) for a in column}) == 1:
                 arrays[f"{kind}/{name}"] = np.stack(column)
+            elif whole and len({a.dtype.str for a in column}) == 1:
+                # shapes differ (grid points decided after different numbers of members):
+                # one flat array and each table's shape
+                arrays[f"r/{kind}/{name}"] = np.concatenate([a.ravel() for a in column])
+                meta["shapes"][f"{kind}/{name}"] = [list(a.shape) for a in column]
             else:
                 for k, a in enumerate(column):
                     arrays[f"{k}/{kind}/{name}"] = a
@@ -235,6 +247,11 @@ def _unpack(path: Path, fingerprint: str) -> dict[int, Table]:
         if meta["fingerprint"] != fingerprint:
             raise ValueError("written by another run")
         stacked = {key: npz[key] for key in npz.files if key[:2] in ("d/", "c/")}
+        for key, shapes in meta.get("shapes", {}).items():
+            flat = npz[f"r/{key}"]
+            ends = np.cumsum([math.prod(shape) for shape in shapes])
+            stacked[key] = [part.reshape(shape) for part, shape
+                            in zip(np.split(flat, ends[:-1]), shapes)]  # fmt: skip
 
         def values(kind, name, k):
             key = f"{kind}/{name}"
