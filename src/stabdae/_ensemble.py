@@ -11,6 +11,7 @@ predictions (:mod:`.theory`).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from collections.abc import Mapping
@@ -44,6 +45,7 @@ from .engine.ensemble.groups import (
     outputs,
 )
 from .engine.ensemble.lanes import LANES, adaptive_block_for
+from .engine.jit import compile_seconds
 from .engine.rk.steps import integrator_for
 from .engine.sampler import CHUNK, SAMPLING_RTOL, draw_alphas, residual_rows_for, sampler_for
 from .engine.threads import default_threads, run_chunks
@@ -331,26 +333,45 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
     times = run.mode.times(run.t0)
     if plan is not None:
         return _sequential_table(run, plan, peak, gain, times)
-    clock = time.perf_counter()
+    walls = _Walls()
     placed = None
     try:
-        x0, alpha0, status, g_ref = placed = _members(run, x0)
-        wall_sample = time.perf_counter() - clock
-        clock = time.perf_counter()
-        out = run.mode.integrate(run, x0, alpha0, status, g_ref)
+        with walls("sample"):
+            x0, alpha0, status, g_ref = placed = _members(run, x0)
+        with walls("integrate"):
+            out = run.mode.integrate(run, x0, alpha0, status, g_ref)
     except Exception as exc:  # a model function raised: say which, when and where
         raise _raised_in(run, "ensemble", exc, None if placed is None else x0) from exc
-    wall_integrate = time.perf_counter() - clock
     status = np.where(status != 0, status, out.status).astype(np.int8)
-    clock = time.perf_counter()
-    referee = _referee(run, g_ref)
-    roundoff = _roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
-                         run.threads, run.sampled)  # fmt: skip
-    table = _build(run, times, x0, alpha0, out, status, referee, peak, roundoff)
-    # wall times (compilation included on a first call) for benchmarks; not part of the data
-    table.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
-                       wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
+    with walls("dataset"):
+        referee = _referee(run, g_ref)
+        roundoff = _roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
+                             run.threads, run.sampled)  # fmt: skip
+        table = _build(run, times, x0, alpha0, out, status, referee, peak, roundoff)
+    table.attrs.update(walls.attrs())
     return table
+
+
+class _Walls:
+    """Wall times of an ensemble's phases (``with walls("integrate"): ...``), each without
+    the compiling (or loading of compiled kernels) inside it, which is counted apart: for
+    benchmarks and a study's account of its time; not part of the data."""
+
+    def __init__(self):
+        self.seconds = {"sample": 0.0, "integrate": 0.0, "dataset": 0.0, "compile": 0.0}
+
+    @contextlib.contextmanager
+    def __call__(self, phase: str):
+        clock, compiling = time.perf_counter(), compile_seconds()
+        try:
+            yield
+        finally:
+            compiled = compile_seconds() - compiling
+            self.seconds["compile"] += compiled
+            self.seconds[phase] += time.perf_counter() - clock - compiled
+
+    def attrs(self) -> dict:
+        return {f"wall_{k}_s": v for k, v in self.seconds.items()}
 
 
 def _build(run, times, x0, alpha0, out, status, referee, peak, roundoff, verdicts=None
@@ -379,25 +400,23 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
     members would give it, with the decision, its reason and interval."""
     looks = plan.looks()
     parts, g_ref, referee, roundoff = [], None, None, 0.0
-    wall_sample = wall_integrate = 0.0
+    walls = _Walls()
     lo = 0
     progress = run.progress
     for j, hi in enumerate(looks):
         sub = replace(run, members=hi - lo, start=lo, trace_row=run.trace_row[lo:hi],
                       progress=None if progress is None
                       else (lambda done, _, lo=lo: progress(lo + done, plan.max)))  # fmt: skip
-        clock = time.perf_counter()
         placed = None
         try:
-            x0, alpha0, status, g = placed = _members(sub, None, reference=g_ref is None)
-            wall_sample += time.perf_counter() - clock
-            clock = time.perf_counter()
-            if g_ref is None:
-                g_ref, referee = g, _referee(run, g)
-            out = run.mode.integrate(sub, x0, alpha0, status, g_ref)
+            with walls("sample"):
+                x0, alpha0, status, g = placed = _members(sub, None, reference=g_ref is None)
+            with walls("integrate"):
+                if g_ref is None:
+                    g_ref, referee = g, _referee(run, g)
+                out = run.mode.integrate(sub, x0, alpha0, status, g_ref)
         except Exception as exc:
             raise _raised_in(sub, "ensemble", exc, None if placed is None else x0) from exc
-        wall_integrate += time.perf_counter() - clock
         status = np.where(status != 0, status, out.status).astype(np.int8)
         parts.append((x0, alpha0, out, status))
         if lo == 0:  # the roundoff level from the first members: the same at any batch
@@ -432,8 +451,8 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
         f"{hi - stable - unstable} undecided): the unstable fraction in "
         f"[{decision.low:.3g}, {decision.high:.3g}] at confidence {plan.confidence:g}, "
         f"q = {plan.q:g}; {DECISION_REASONS[decision.reason]}")  # fmt: skip
-    table.attrs.update(wall_sample_s=wall_sample, wall_integrate_s=wall_integrate,
-                       wall_dataset_s=time.perf_counter() - clock)  # fmt: skip
+    walls.seconds["dataset"] = time.perf_counter() - clock
+    table.attrs.update(walls.attrs())
     return table
 
 

@@ -203,8 +203,16 @@ def power_norms(R, max_steps: int = 100_000) -> tuple[float, float]:
     R = np.ascontiguousarray(R, dtype=float)
     if R.ndim != 2 or R.shape[0] != R.shape[1]:
         raise ValueError(f"power_norms: R must be a square matrix, got shape {R.shape}")
-    peak, total = _power_walk(R, int(max_steps))
-    return float(peak), float(total)
+    key = (R.shape, R.tobytes(), int(max_steps))
+    if key not in _POWER_NORMS:  # (an ensemble asks twice: its threshold and its gain)
+        if len(_POWER_NORMS) >= 64:
+            _POWER_NORMS.pop(next(iter(_POWER_NORMS)))
+        peak, total = _power_walk(R, int(max_steps))
+        _POWER_NORMS[key] = (float(peak), float(total))
+    return _POWER_NORMS[key]
+
+
+_POWER_NORMS: dict = {}
 
 
 def fifth_bounds(R, nsteps: int) -> np.ndarray:

@@ -486,3 +486,30 @@ def test_a_cache_entry_knows_which_kernel_it_is(model_folder, tmp_path):
     assert third["x"] == first["x"]
     assert any("does not match" in w for w in third["warnings"]), third
     assert run()["warnings"] == []  # sound again
+
+
+def test_compile_seconds_counts_the_compiling_of_a_new_function_and_nothing_else():
+    """The clock of numba's compiler lock moves by the time a new function takes to
+    compile, and not while compiled code runs."""
+    import time
+
+    import numba
+
+    from stabdae.engine.jit import compile_seconds
+
+    offset = time.time_ns()  # a constant of its own: never in any cache
+
+    @numba.njit
+    def fresh(x):
+        s = 0.0
+        for i in range(x):
+            s += (i * offset) % 7
+        return s
+
+    before, clock = compile_seconds(), time.perf_counter()
+    fresh(10)
+    elapsed, counted = time.perf_counter() - clock, compile_seconds() - before
+    assert 0.8 * elapsed <= counted <= elapsed
+    before, clock = compile_seconds(), time.perf_counter()
+    fresh(3_000_000)
+    assert compile_seconds() - before < 0.01 * max(time.perf_counter() - clock, 0.01)

@@ -415,6 +415,23 @@ def test_a_dataset_that_cannot_be_written_leaves_every_point_to_resume(tmp_path,
     assert "resuming: 6 of 6 grid points already done" in said
 
 
+def test_the_run_accounts_for_its_time(tmp_path):
+    """The run's last line splits its wall time into sampling and integration, compiling
+    (or loading compiled code), and the rest, and they add up to it."""
+    import re
+
+    said = []
+    run_study(study_file(tmp_path, members=16, t_end=0.2, omegas="5.0"), progress=False,
+              log=said.append)  # fmt: skip
+    line = str(said[-1])
+    m = re.search(r"in ([\d.]+) s: sampling and integration ([\d.]+) s, compiling or loading "
+                  r"compiled code ([\d.]+) s, the rest (-?[\d.]+) s\)", line)  # fmt: skip
+    assert m, line
+    wall, work, compiled, rest = map(float, m.groups())
+    assert min(work, compiled, rest) >= 0.0
+    assert work + compiled + rest == pytest.approx(wall, abs=0.025)
+
+
 def test_force_never_removes_what_stabdae_did_not_write(tmp_path):
     """A folder at OUTPUT.parts that no stabdae run wrote (no manifest) is refused, with
     and without --force, and left as it was; the parts of another study are discarded by

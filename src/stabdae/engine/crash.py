@@ -10,9 +10,9 @@ signal to the handler that was there before (Python's ``faulthandler``, if enabl
 prints the Python stack; otherwise the process dies as before).  The process is not
 saved: the memory may already be corrupt.
 
-The handler is a numba ``cfunc`` that calls only ``write``, ``strlen`` and ``sigaction``
-(async-signal-safe), compiled once per process under the first guard (about 0.4 s: the
-addresses it writes from are this process's).  Linux only; elsewhere, or with
+The handler calls only ``write``, ``strlen`` and ``sigaction`` (async-signal-safe); it is a
+few lines of LLVM IR compiled by llvmlite once per process under the first guard, with the
+addresses it writes from (this process's) as constants.  Linux only; elsewhere, or with
 ``STABDAE_CRASH_MESSAGE=off``, nothing is installed.
 """
 
@@ -61,33 +61,66 @@ def _enabled() -> bool:
 def _libc_functions():
     libc = ctypes.CDLL(None)
 
-    def fn(name, restype, *argtypes):  # pointers passed as size_t: numba takes integers
+    def fn(name, restype, *argtypes):
         f = getattr(libc, name)
         f.argtypes, f.restype = list(argtypes), restype
         return f
 
     size_t = ctypes.c_size_t
-    return (fn("write", ctypes.c_ssize_t, ctypes.c_int, size_t, size_t),
-            fn("strlen", size_t, size_t),
-            fn("sigaction", ctypes.c_int, ctypes.c_int, size_t, size_t))  # fmt: skip
+    return {"write": fn("write", ctypes.c_ssize_t, ctypes.c_int, size_t, size_t),
+            "strlen": fn("strlen", size_t, size_t),
+            "sigaction": fn("sigaction", ctypes.c_int, ctypes.c_int, size_t, size_t)}
+
+
+class _Handler:
+    """The machine code of the handler (LLVM IR compiled by llvmlite's MCJIT, kept alive
+    with its engine) and its address."""
+
+    def __init__(self, engine, address: int):
+        self.engine, self.address = engine, address
 
 
 def _compile_handler():
-    from numba import cfunc, types
+    """``handler(sig)``: ``write(2, message, strlen(message))``, then ``sigaction(sig,
+    <the handler before ours>, NULL)``.  Written in LLVM IR with this process's addresses
+    as constants (libc's functions, the message, the saved actions): compiling it takes
+    milliseconds, where a numba ``cfunc`` first set up numba's whole compiler (tenths of
+    a second per process, and it cannot be cached: the addresses are this process's)."""
+    import llvmlite.binding as llvm
+    import llvmlite.ir as ir
 
-    c_write, c_strlen, c_sigaction = _libc_functions()
-    text = ctypes.addressof(_MESSAGE)
-    segv = int(signal.SIGSEGV)
-    old_segv = ctypes.addressof(_OLD[signal.SIGSEGV])
-    old_other = ctypes.addressof(_OLD[_SIGNALS[-1]])
+    libc = _libc_functions()
+    i8p, i32, i64 = ir.IntType(8).as_pointer(), ir.IntType(32), ir.IntType(64)
+    module = ir.Module(name="stabdae_crash")
+    fn = ir.Function(module, ir.FunctionType(ir.VoidType(), [i32]), name="stabdae_crash")
+    b = ir.IRBuilder(fn.append_basic_block())
 
-    @cfunc(types.void(types.int32))
-    def handler(sig):
-        c_write(2, text, c_strlen(text))
-        # the handler before ours takes over; the faulting instruction runs again on return
-        c_sigaction(sig, old_segv if sig == segv else old_other, 0)
+    def address(value: int):
+        return ir.Constant(i64, value)
 
-    return handler, c_sigaction
+    def callee(name, ret, *args):
+        at = ctypes.cast(libc[name], ctypes.c_void_p).value
+        return b.inttoptr(address(at), ir.FunctionType(ret, list(args)).as_pointer())
+
+    text = b.inttoptr(address(ctypes.addressof(_MESSAGE)), i8p)
+    length = b.call(callee("strlen", i64, i8p), [text])
+    b.call(callee("write", i64, i32, i8p, i64), [ir.Constant(i32, 2), text, length])
+    sig = fn.args[0]
+    # the handler before ours takes over; the faulting instruction runs again on return
+    old = b.select(b.icmp_signed("==", sig, ir.Constant(i32, int(signal.SIGSEGV))),
+                   address(ctypes.addressof(_OLD[signal.SIGSEGV])),
+                   address(ctypes.addressof(_OLD[_SIGNALS[-1]])))  # fmt: skip
+    b.call(callee("sigaction", i32, i32, i8p, i8p),
+           [sig, b.inttoptr(old, i8p), ir.Constant(i8p, None)])  # fmt: skip
+    b.ret_void()
+    llvm.initialize_native_target()
+    llvm.initialize_native_asmprinter()
+    parsed = llvm.parse_assembly(str(module))
+    parsed.verify()
+    machine = llvm.Target.from_default_triple().create_target_machine()
+    engine = llvm.create_mcjit_compiler(parsed, machine)
+    engine.finalize_object()
+    return _Handler(engine, engine.get_function_address("stabdae_crash")), libc["sigaction"]
 
 
 def _install(who: str) -> None:
@@ -122,7 +155,7 @@ def guard(who: str):
             try:
                 _install(who)
                 entered = True
-            except Exception:  # no libc, no numba cfunc: run without the message
+            except Exception:  # no libc, no LLVM target: run without the message
                 _state["failed"] = True
         elif _state["depth"] > 0:
             entered = True

@@ -1,4 +1,5 @@
-"""Whether the library compiles, and the compiled functions it is given.
+"""Whether the library compiles, the compiled functions it is given, and the time it
+spends compiling (:func:`compile_seconds`).
 
 With ``NUMBA_DISABLE_JIT=1`` in the environment, ``@njit`` returns the Python function
 itself: a model's functions then arrive as plain functions, the library's kernels run as
@@ -9,11 +10,14 @@ the intrinsics have Python stand-ins (:mod:`.fma`, :mod:`.workspace`).
 from __future__ import annotations
 
 import inspect
+import threading
+import time
 
 from numba import config
+from numba.core import event
 from numba.core.dispatcher import Dispatcher
 
-__all__ = ["JIT", "is_njit", "python_function"]
+__all__ = ["JIT", "compile_seconds", "is_njit", "python_function"]
 
 #: False when numba's JIT is switched off (``NUMBA_DISABLE_JIT=1``)
 JIT = not config.DISABLE_JIT
@@ -28,3 +32,40 @@ def is_njit(fn) -> bool:
 def python_function(fn):
     """The Python function behind a dispatcher (the function itself without the JIT)."""
     return getattr(fn, "py_func", fn)
+
+
+class _CompileClock(event.Listener):
+    """Wall time during which some thread held (or waited for) numba's compiler lock."""
+
+    def __init__(self):
+        self.total, self.depth, self.since = 0.0, 0, 0.0
+        self.lock = threading.Lock()
+
+    def on_start(self, ev):
+        with self.lock:
+            if self.depth == 0:
+                self.since = time.perf_counter()
+            self.depth += 1
+
+    def on_end(self, ev):
+        with self.lock:
+            self.depth -= 1
+            if self.depth == 0:
+                self.total += time.perf_counter() - self.since
+
+    def seconds(self) -> float:
+        with self.lock:
+            return self.total + (time.perf_counter() - self.since if self.depth else 0.0)
+
+
+_CLOCK = _CompileClock()
+event.register("numba:compiler_lock", _CLOCK)
+
+
+def compile_seconds() -> float:
+    """Seconds this process has spent under numba's compiler lock since the library was
+    imported: compiling, or loading compiled code from the cache (the first such load in
+    a process also sets up numba's compiler, tenths of a second).  The difference of two
+    readings is the compiling between them (the wall time during which some thread
+    compiled or waited to)."""
+    return _CLOCK.seconds()

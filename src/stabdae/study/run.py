@@ -37,6 +37,7 @@ from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
 from ..engine.cache import function_fingerprint, library_fingerprint
 from ..engine.crash import guard
+from ..engine.jit import compile_seconds
 from .report import summary
 from .spec import Study, StudyError, load_study, members_text, most_members
 from .store import Manifest, Store, clear, stack
@@ -46,8 +47,8 @@ __all__ = ["run_study", "run_point", "combine"]
 
 #: attributes that say when/how fast, not what, and the parts' bookkeeping: left out of
 #: the study dataset
-_VOLATILE = ("wall_sample_s", "wall_integrate_s", "wall_dataset_s", "created_at", "history",
-             "threads", "stabdae_run_key", "grid_point")  # fmt: skip
+_VOLATILE = ("wall_sample_s", "wall_integrate_s", "wall_dataset_s", "wall_compile_s",
+             "created_at", "history", "threads", "stabdae_run_key", "grid_point")  # fmt: skip
 #: the volatile attributes that time a point's own work (its sampling and integration)
 _WORK = ("wall_sample_s", "wall_integrate_s")
 
@@ -263,7 +264,7 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
     todo = [(i, values) for i, (_, values) in enumerate(points) if i not in store.tables]
     if len(todo) < len(points):
         log(f"resuming: {len(points) - len(todo)} of {len(points)} grid points already done")
-    start = time.perf_counter()
+    start, compiling = time.perf_counter(), compile_seconds()
     bar = _Progress(len(points), len(points) - len(todo), _work_per_point(study), progress)
     work = [0.0]  # the points' sampling and integration, in seconds
 
@@ -300,11 +301,13 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
         raise
     clear(parts)
     log(summary(ds))
-    wall = time.perf_counter() - start
+    wall, compiled = time.perf_counter() - start, compile_seconds() - compiling
     timing = ""
     if todo and not (workers or scheduler):  # (on workers, the times are theirs)
+        # the points' own times leave compiling out; it is counted once, here
         timing = (f" ({len(todo)} grid points in {wall:.2f} s: sampling and integration "
-                  f"{work[0]:.2f} s, the rest {wall - work[0]:.2f} s)")  # fmt: skip
+                  f"{work[0]:.2f} s, compiling or loading compiled code {compiled:.2f} s, "
+                  f"the rest {wall - work[0] - compiled:.2f} s)")  # fmt: skip
     log(f"dataset written to {out}{timing}")
     return out
 

@@ -371,14 +371,20 @@ def _padded_sizes(tables: list[Table]) -> dict:
     return out
 
 
-def _padded(name: str, vdims: tuple, values: np.ndarray, sizes: dict) -> np.ndarray:
-    """``values`` padded to ``sizes`` along its dimensions: NaN for real numbers, a
-    member's not-run code (:data:`.._ensemble_dataset.NOT_RUN`) or 0 for integers."""
-    pad = [(0, sizes[d][0] - n if d in sizes else 0) for d, n in zip(vdims, values.shape)]
-    if not any(p[1] for p in pad):
-        return values
-    fill = np.nan if values.dtype.kind in "fc" else NOT_RUN.get(name, 0)
-    return np.pad(values, pad, constant_values=fill)
+def _column(name: str, vdims: tuple, values: list, sizes: dict) -> np.ndarray:
+    """The tables' ``values`` of one variable stacked on a new first axis, each padded to
+    ``sizes`` along its dimensions: NaN for real numbers, a member's not-run code
+    (:data:`.._ensemble_dataset.NOT_RUN`) or 0 for integers."""
+    shapes = {v.shape for v in values}
+    if len(shapes) == 1 and not any(d in sizes for d in vdims):
+        return np.stack(values)
+    shape = tuple(sizes[d][0] if d in sizes else n for d, n in zip(vdims, values[0].shape))
+    dtype = np.result_type(*values)
+    fill = np.nan if dtype.kind in "fc" else NOT_RUN.get(name, 0)
+    out = np.full((len(values), *shape), fill, dtype=dtype)
+    for k, v in enumerate(values):
+        out[(k, *(slice(0, n) for n in v.shape))] = v
+    return out
 
 
 def stack(tables: list[Table], axes: dict[str, np.ndarray]) -> xr.Dataset:
@@ -393,8 +399,7 @@ def stack(tables: list[Table], axes: dict[str, np.ndarray]) -> xr.Dataset:
     data = {}
     for name, (vdims, _, _) in first.data.items():
         vd = tuple(_dims(vdims))
-        column = np.stack([_padded(name, vd, np.asarray(t.data[name][1]), sizes)
-                           for t in tables])  # fmt: skip
+        column = _column(name, vd, [np.asarray(t.data[name][1]) for t in tables], sizes)
         attrs = common_attrs([t.data[name][2] for t in tables])
         data[name] = xr.Variable(dims + vd, column.reshape(shape + column.shape[1:]),
                                  attrs)  # fmt: skip
