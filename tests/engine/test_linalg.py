@@ -211,3 +211,32 @@ def test_written_out_routines_for_a_pattern_skip_its_zeros_only(shape):
     assert np.all(Xd[~Xpat] == 0.0) and np.all(X[~Xpat] == 9.0)
     if shape == "blocks":  # a column's non-zeros fill their blocks, no more
         assert Xpat.sum() == 4 + 4 + 3 and ops < n * n * 3
+
+
+def test_written_out_code_reads_and_writes_each_entry_once():
+    """The written-out factor and solves keep every entry in a local: each array entry is
+    read at most once (at the start) and written at most once (before the return), where
+    the operations read and write them a cubic number of times; indexing that is not by
+    constants is left as it is."""
+    import inspect
+    import re
+
+    from stabdae.engine import linalg
+
+    n = 8
+    for fn in (linalg.ldl_factor_for(n), linalg.ldl_solve_for(n),
+               linalg.ldl_solve_columns_for(n, 3)):  # fmt: skip
+        source = inspect.getsource(getattr(fn, "py_func", fn))
+        reads = re.findall(r"_at\d\((\w+), ([\d, ]+)\)", source)
+        writes = re.findall(r"_set\d\((\w+), ([\d, ]+), ", source)
+        assert reads and writes
+        assert len(reads) == len(set(reads)) and len(writes) == len(set(writes))
+        assert "[" not in source.split(":", 1)[1]  # no subscript left in the body
+    source = linalg._scalarized("def f(a, b, k):\n    s = a[0, 1]\n    s = s + a[k, 1]\n"
+                                "    b[1] *= s\n    b[0] = s\n    b[0] *= 2.0\n"
+                                "    return s\n")  # fmt: skip
+    assert "a[k, 1]" in source and "a[0, 1]" in source  # a has a dynamic index: kept
+    assert source.index("_at1(b, 1)") < source.index("_b_1 *= s")  # read, then scaled
+    assert "_at1(b, 0)" not in source  # written before it is read: never loaded
+    assert source.index("_set1(b, 1, _b_1)") < source.index("return s")
+    assert source.index("_set1(b, 0, _b_0)") < source.index("return s")

@@ -30,13 +30,16 @@ numbers are the dense routines' up to the sign of a zero.
 
 from __future__ import annotations
 
+import ast
 import math
 from functools import cache
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import intrinsic
 
-from .fma import fma
+from .fma import HOST_FMA, _fused, fma
+from .jit import JIT
 from .source import exec_source
 from .sparsity import fill_pattern
 
@@ -339,9 +342,167 @@ def _solve_lines(n: int, at, L: tuple, b: tuple) -> tuple[list[str], tuple, int]
 
 
 def _written_out(header: str, lines: list[str], label: str):
-    source = header + "\n" + "".join(f"    {line}\n" for line in lines or ["pass"])
-    fn = exec_source(source, label, {"fma": fma})[header[4:header.index("(")]]
+    source = _scalarized(header + "\n" + "".join(f"    {line}\n" for line in lines or ["pass"]))
+    fn = exec_source(source, label, {"fma": _WRITTEN_FMA, **_ENTRY})[header[4:header.index("(")]]
     return njit(error_model="numpy", forceinline=True)(fn)
+
+
+def _entry_pointer(context, builder, aryty, ary, indices):
+    from numba.core import cgutils
+
+    array = context.make_array(aryty)(context, builder, ary)
+    inds = [context.cast(builder, i, t, types.intp) for i, t in indices]
+    return cgutils.get_item_pointer(context, builder, aryty, array, inds)
+
+
+def _load_intrinsic(ndim):
+    def typer(typingctx, a, *index):
+        if not (isinstance(a, types.Array) and a.ndim == ndim and len(index) == ndim
+                and all(isinstance(i, types.Integer) for i in index)):  # fmt: skip
+            return None
+
+        def codegen(context, builder, sig, args):
+            ptr = _entry_pointer(context, builder, sig.args[0], args[0],
+                                 list(zip(args[1:], sig.args[1:])))  # fmt: skip
+            return builder.load(ptr)
+
+        return a.dtype(a, *index), codegen
+
+    return typer
+
+
+def _store_intrinsic(ndim):
+    def typer(typingctx, a, *rest):
+        index, value = rest[:-1], rest[-1]
+        if not (isinstance(a, types.Array) and a.ndim == ndim and len(index) == ndim
+                and all(isinstance(i, types.Integer) for i in index)
+                and isinstance(value, (types.Float, types.Integer))):  # fmt: skip
+            return None
+
+        def codegen(context, builder, sig, args):
+            aryty = sig.args[0]
+            ptr = _entry_pointer(context, builder, aryty, args[0],
+                                 list(zip(args[1:-1], sig.args[1:-1])))  # fmt: skip
+            builder.store(context.cast(builder, args[-1], sig.args[-1], aryty.dtype), ptr)
+            return context.get_dummy_value()
+
+        return types.none(a, *rest), codegen
+
+    return typer
+
+
+def _at1(typingctx, a, i):
+    return _load_intrinsic(1)(typingctx, a, i)
+
+
+def _at2(typingctx, a, i, j):
+    return _load_intrinsic(2)(typingctx, a, i, j)
+
+
+def _set1(typingctx, a, i, v):
+    return _store_intrinsic(1)(typingctx, a, i, v)
+
+
+def _set2(typingctx, a, i, j, v):
+    return _store_intrinsic(2)(typingctx, a, i, j, v)
+
+
+def _py_at(a, *index):
+    return a[index]
+
+
+def _py_set(a, *rest):
+    a[rest[:-1]] = rest[-1]
+
+
+#: what the written-out code reads and writes an array's entry with: intrinsics (a load or
+#: a store at the entry's address, what indexing by constants compiles to) where the JIT
+#: runs, for numba types every subscript through each of its overloads of ``getitem`` and
+#: ``setitem``, at compiling and again at lowering, a few milliseconds a subscript
+if JIT:
+    _ENTRY = {"_at1": intrinsic(_at1), "_at2": intrinsic(_at2), "_set1": intrinsic(_set1),
+              "_set2": intrinsic(_set2)}  # fmt: skip
+else:
+    _ENTRY = {"_at1": _py_at, "_at2": _py_at, "_set1": _py_set, "_set2": _py_set}
+
+
+#: the written-out code's ``fma``: the fused multiply-add's intrinsic itself where there
+#: is one (the same instruction as :func:`.fma.fma`, which wraps it, without a function
+#: call per multiply-add for numba to type and lower: a tenth of a large factor's compile)
+_WRITTEN_FMA = _fused if (JIT and HOST_FMA) else fma
+
+
+def _entry(node) -> tuple | None:
+    """``(array, (i, j, ...))`` of a subscript by integer constants, else None."""
+    if not (isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name)):
+        return None
+    index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+    if not all(isinstance(i, ast.Constant) and type(i.value) is int for i in index):
+        return None
+    return node.value.id, tuple(i.value for i in index)
+
+
+def _scalarized(source: str) -> str:
+    """The straight-line function ``source`` with each array entry it indexes by constants
+    held in a local variable: read from its array once, before the first statement,
+    where the code reads it before writing it, and written back once, before the
+    ``return`` (or at the end), where the code writes it.  The same operations on the same
+    values in the same order, so the same bits (the arguments are distinct buffers: no
+    entry is reached through two names).  numba types every subscript by trying each of
+    its overloads of ``getitem`` and ``setitem`` in turn, about as long as all the
+    arithmetic around it: a factor written out for a size of 10 read its entries a
+    thousand times, now a hundred."""
+    fn = ast.parse(source).body[0]
+    dynamic = {n.value.id for n in ast.walk(fn) if isinstance(n, ast.Subscript)
+               and isinstance(n.value, ast.Name) and _entry(n) is None}  # fmt: skip
+    local: dict = {}  # entry -> its local's name
+    loads: list = []  # entries read before they are written
+    stores: list = []  # entries written
+
+    def name(key, ctx, read):
+        if key not in local:
+            local[key] = "_" + key[0] + "".join(f"_{i}" for i in key[1])
+            if read:
+                loads.append(key)
+        if isinstance(ctx, ast.Store) and key not in stores:
+            stores.append(key)
+        return ast.Name(id=local[key], ctx=ctx)
+
+    class Locals(ast.NodeTransformer):
+        def visit_Subscript(self, node):
+            key = _entry(node)
+            if key is None or key[0] in dynamic:
+                return self.generic_visit(node)
+            return name(key, node.ctx, read=not isinstance(node.ctx, ast.Store))
+
+        def visit_Assign(self, node):  # the value is evaluated before the targets
+            node.value = self.visit(node.value)
+            node.targets = [self.visit(t) for t in node.targets]
+            return node
+
+        def visit_AugAssign(self, node):  # ``a[i] *= x`` reads a[i] first
+            node.value = self.visit(node.value)
+            key = _entry(node.target)
+            if key is not None and key[0] not in dynamic:
+                name(key, ast.Load(), read=True)
+            node.target = self.visit(node.target)
+            return node
+
+    body = [Locals().visit(stmt) for stmt in fn.body]
+
+    def call(fn, key, *more):
+        args = [ast.Name(key[0], ast.Load()), *(ast.Constant(i) for i in key[1]), *more]
+        return ast.Call(ast.Name(f"{fn}{len(key[1])}", ast.Load()), args, [])
+
+    head = [ast.Assign([ast.Name(local[k], ast.Store())], call("_at", k)) for k in loads]
+    tail = [ast.Expr(call("_set", k, ast.Name(local[k], ast.Load()))) for k in stores]
+    ret = [i for i, stmt in enumerate(body) if isinstance(stmt, ast.Return)]
+    if any(isinstance(n, ast.Return) for stmt in body for n in ast.walk(stmt)
+           if not isinstance(stmt, ast.Return)) or ret[:-1]:  # fmt: skip
+        return source  # (only straight-line code with one return at its end is rewritten)
+    at = ret[0] if ret else len(body)
+    fn.body = head + body[:at] + tail + body[at:] or [ast.Pass()]
+    return ast.unparse(ast.fix_missing_locations(fn)) + "\n"
 
 
 def _label(base: str, pattern) -> str:
