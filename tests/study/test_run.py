@@ -335,21 +335,10 @@ def test_bad_parts_are_computed_again_and_force_keeps_good_ones(tmp_path, monkey
     same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
 
 
-def test_the_store_gives_back_every_table_as_it_was(tmp_path):
-    """A chunk read back gives each grid point's table exactly: the values, their types,
-    the dimensions, every attribute (numpy scalars and arrays of their own type, a
-    variable's attribute that differs between points, a global one that one point lacks)
-    and the coordinates."""
-    from stabdae.study.spec import load_study
+def _stored_and_read_back(tmp_path, tables):
+    """A store that wrote ``tables`` as one chunk, and a second one that read it back."""
     from stabdae.study.store import Manifest, Store
 
-    study = load_study(study_file(tmp_path, members=16, t_end=0.2, omegas="5.0, 30.0"))
-    from stabdae.study.run import run_point
-
-    tables = {i: run_point(study, values) for i, (_, values) in enumerate(study.points())}
-    tables[3].data["stability_radius"][2]["comment"] = "this point's own"
-    tables[2].attrs["only_here"] = np.float32(0.25)
-    del tables[1].attrs["model"]
     parts = tmp_path / "parts"
     parts.mkdir()
     store = Store(Manifest(parts, "key", "study"))
@@ -358,6 +347,24 @@ def test_the_store_gives_back_every_table_as_it_was(tmp_path):
     store.flush()
     again = Store(Manifest.read(parts))
     again.resume(len(tables), log=lambda *a: pytest.fail(str(a)))
+    return again
+
+
+def test_the_store_gives_back_every_table_as_it_was(tmp_path):
+    """A chunk read back gives each grid point's table exactly: the values, their types,
+    the dimensions, every attribute (numpy scalars and arrays of their own type, a
+    variable's attribute that differs between points, a global one that one point lacks)
+    and the coordinates."""
+    from stabdae.study.spec import load_study
+
+    study = load_study(study_file(tmp_path, members=16, t_end=0.2, omegas="5.0, 30.0"))
+    from stabdae.study.run import run_point
+
+    tables = {i: run_point(study, values) for i, (_, values) in enumerate(study.points())}
+    tables[3].data["stability_radius"][2]["comment"] = "this point's own"
+    tables[2].attrs["only_here"] = np.float32(0.25)
+    del tables[1].attrs["model"]
+    again = _stored_and_read_back(tmp_path, tables)
     assert sorted(again.tables) == sorted(tables)
     for i, table in tables.items():
         got = again.tables[i]
@@ -373,7 +380,6 @@ def test_the_store_gives_back_tables_of_different_member_counts(tmp_path):
     variable's tables of different shapes come back each with its own shape and values."""
     from stabdae.study.run import run_point
     from stabdae.study.spec import load_study
-    from stabdae.study.store import Manifest, Store
 
     tables = {}
     for i, members in enumerate((16, 48, 32)):
@@ -382,14 +388,7 @@ def test_the_store_gives_back_tables_of_different_member_counts(tmp_path):
                                       omegas="5.0"))  # fmt: skip
         tables[i] = run_point(study, next(iter(study.points()))[1])
     assert len({t.data["alpha0"][1].shape for t in tables.values()}) == 3
-    parts = tmp_path / "parts"
-    parts.mkdir()
-    store = Store(Manifest(parts, "key", "study"))
-    for i, table in tables.items():
-        store.add(i, table)
-    store.flush()
-    again = Store(Manifest.read(parts))
-    again.resume(len(tables), log=lambda *a: pytest.fail(str(a)))
+    again = _stored_and_read_back(tmp_path, tables)
     for i, table in tables.items():
         xr.testing.assert_identical(again.tables[i].to_dataset(), table.to_dataset())
 
