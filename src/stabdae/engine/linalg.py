@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import intrinsic
 
-from .fma import HOST_FMA, _fused, fma
+from .fma import HOST_FMA, _fused, _fused_negated, fma
 from .jit import JIT
 from .source import exec_source
 from .sparsity import fill_pattern
@@ -299,12 +299,12 @@ def _factor_lines(n: int, L: tuple) -> tuple[list[str], int]:
         for p in row:
             out.append(f"s = a[{j}, {p}]")
             terms = [q for q in range(p) if L[j][q] and L[p][q]]
-            out += [f"s = fma(-a[{j}, {q}], a[{p}, {q}], s)" for q in terms]
+            out += [f"s = fnma(a[{j}, {q}], a[{p}, {q}], s)" for q in terms]
             out.append(f"a[{j}, {p}] = s")
             ops += len(terms) + 1
         out.append(f"d = a[{j}, {j}]")
         for p in row:
-            out += [f"w = a[{j}, {p}]", f"ljp = w * a[{p}, {p}]", "d = fma(-w, ljp, d)",
+            out += [f"w = a[{j}, {p}]", f"ljp = w * a[{p}, {p}]", "d = fnma(w, ljp, d)",
                     f"a[{j}, {p}] = ljp"]  # fmt: skip
         out += ["bad = not (d > tol)", f"fail += {j + 1} * (bad & (fail == 0))",
                 f"a[{j}, {j}] = 1.0 / d"]  # fmt: skip
@@ -325,7 +325,7 @@ def _solve_lines(n: int, at, L: tuple, b: tuple) -> tuple[list[str], tuple, int]
         if not (known[i] or terms):
             return False
         out.append(f"s = {at(i)}" if known[i] else "s = -0.0")
-        out.extend(f"s = fma(-{l_}, {at(p)}, s)" for p, l_ in terms)
+        out.extend(f"s = fnma({l_}, {at(p)}, s)" for p, l_ in terms)
         out.append(f"{at(i)} = s")
         ops += len(terms)
         return True
@@ -343,7 +343,8 @@ def _solve_lines(n: int, at, L: tuple, b: tuple) -> tuple[list[str], tuple, int]
 
 def _written_out(header: str, lines: list[str], label: str):
     source = _scalarized(header + "\n" + "".join(f"    {line}\n" for line in lines or ["pass"]))
-    fn = exec_source(source, label, {"fma": _WRITTEN_FMA, **_ENTRY})[header[4:header.index("(")]]
+    names = {"fma": _WRITTEN_FMA, "fnma": _WRITTEN_FNMA, **_ENTRY}
+    fn = exec_source(source, label, names)[header[4:header.index("(")]]
     return njit(error_model="numpy", forceinline=True)(fn)
 
 
@@ -430,6 +431,20 @@ else:
 #: is one (the same instruction as :func:`.fma.fma`, which wraps it, without a function
 #: call per multiply-add for numba to type and lower: a tenth of a large factor's compile)
 _WRITTEN_FMA = _fused if (JIT and HOST_FMA) else fma
+
+
+def _fnma(a, b, c):
+    return fma(-a, b, c)
+
+
+#: ... and its ``fnma(a, b, c)``, ``fma(-a, b, c)`` (most of a factor's and a solve's
+#: multiply-adds subtract: the negation inside the intrinsic is one statement less each)
+if JIT and HOST_FMA:
+    _WRITTEN_FNMA = _fused_negated
+elif JIT:
+    _WRITTEN_FNMA = njit(cache=True, forceinline=True, error_model="numpy")(_fnma)
+else:
+    _WRITTEN_FNMA = _fnma
 
 
 def _entry(node) -> tuple | None:
