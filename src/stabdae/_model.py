@@ -20,6 +20,7 @@ energy      ``energy(t, q, v, p)``       float     optional, for drift diagnosti
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 import traceback
@@ -258,11 +259,11 @@ class Model:
     def state_names(self) -> list[str]:
         return list(self.coordinates) + [f"{c}_dot" for c in self.coordinates]
 
-    @property
+    @functools.cached_property  # (the declarations are fixed at construction)
     def state_units(self) -> list[str]:
         return list(self.coordinate_units) + [_per_second(u) for u in self.coordinate_units]
 
-    @property
+    @functools.cached_property  # (the declarations are fixed at construction)
     def component_units(self) -> list[str]:
         """Units of the residual components ``(f, ḟ, h)``."""
         f_units = list(self.constraint_units[: self.m])
@@ -273,7 +274,7 @@ class Model:
         """The constraint each multiplier λ belongs to: ``f_i``, then ``h_j``."""
         return [f"f_{i}" for i in range(self.m)] + [f"h_{j}" for j in range(self.k)]
 
-    @property
+    @functools.cached_property  # (the declarations are fixed at construction)
     def multiplier_units(self) -> list[str]:
         """Units of λ: energy per constraint unit (``Fᵀλ`` is a generalized force); a
         velocity constraint's row of F is ∂h/∂v, so there per constraint unit and second."""
@@ -283,7 +284,7 @@ class Model:
         return ([units_quotient(self.energy_units, u) for u in cu[: self.m]]
                 + [units_quotient(self.energy_units, f"{u} s") for u in cu[self.m:]])  # fmt: skip
 
-    @property
+    @functools.cached_property  # (the declarations are fixed at construction)
     def acceleration_units(self) -> list[str]:
         from ._schema import units_quotient
 

@@ -383,25 +383,6 @@ def _common(units) -> str | None:
     return units.pop() if len(units) == 1 else None
 
 
-#: ``_common_units``' answers by the model's unit declarations (a study builds each grid
-#: point's ~70 variables, and the unit lists behind them, from the same few)
-_COMMON_UNITS: dict = {}
-
-
-def _common_units(model, coord: str) -> str | None:
-    """The one unit of the model's list ``coord`` (``state_units``, …), or None."""
-    try:
-        key = (coord, tuple(model.coordinate_units), tuple(model.constraint_units),
-               model.energy_units, model.m)  # fmt: skip
-    except (AttributeError, TypeError):  # not a Model: its lists as they are
-        return _common(getattr(model, coord))
-    if key not in _COMMON_UNITS:
-        if len(_COMMON_UNITS) > 1024:
-            _COMMON_UNITS.clear()
-        _COMMON_UNITS[key] = _common(getattr(model, coord))
-    return _COMMON_UNITS[key]
-
-
 #: markers of variables whose entries each have their own unit -> the model property (and
 #: the dataset coordinate of the same name) that lists them
 _PER_ENTRY = {STATE: "state_units", COMPONENT: "component_units", RESIDUAL: "component_units",
@@ -416,7 +397,7 @@ def _resolve_units(marker: str, model) -> dict:
     coord = _PER_ENTRY.get(marker)
     if coord is None:
         return {"units": marker}
-    common = _common_units(model, coord) if model is not None else None
+    common = _common(getattr(model, coord)) if model is not None else None
     if common:
         return {"units": common}
     out = {"units_per_component": coord}

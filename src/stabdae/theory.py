@@ -36,6 +36,7 @@ iteration contracts in *some* norm iff ``ρ(R) < 1``, and ``P`` above is one suc
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -203,16 +204,14 @@ def power_norms(R, max_steps: int = 100_000) -> tuple[float, float]:
     R = np.ascontiguousarray(R, dtype=float)
     if R.ndim != 2 or R.shape[0] != R.shape[1]:
         raise ValueError(f"power_norms: R must be a square matrix, got shape {R.shape}")
-    key = (R.shape, R.tobytes(), int(max_steps))
-    if key not in _POWER_NORMS:  # (an ensemble asks twice: its threshold and its gain)
-        if len(_POWER_NORMS) >= 64:
-            _POWER_NORMS.pop(next(iter(_POWER_NORMS)))
-        peak, total = _power_walk(R, int(max_steps))
-        _POWER_NORMS[key] = (float(peak), float(total))
-    return _POWER_NORMS[key]
+    # (an ensemble asks twice for the same matrix: its threshold and its gain)
+    return _power_norms_of(R.shape[0], R.tobytes(), int(max_steps))
 
 
-_POWER_NORMS: dict = {}
+@functools.lru_cache(maxsize=64)
+def _power_norms_of(n: int, data: bytes, max_steps: int) -> tuple[float, float]:
+    peak, total = _power_walk(np.frombuffer(data).reshape(n, n).copy(), max_steps)
+    return float(peak), float(total)
 
 
 def fifth_bounds(R, nsteps: int) -> np.ndarray:
