@@ -226,7 +226,7 @@ def test_written_out_code_reads_and_writes_each_entry_once():
     n = 8
     for fn in (linalg.ldl_factor_for(n), linalg.ldl_solve_for(n),
                linalg.ldl_solve_columns_for(n, 3)):  # fmt: skip
-        source = inspect.getsource(getattr(fn, "py_func", fn))
+        source = inspect.getsource(getattr(fn, "straight_line", fn))
         reads = re.findall(r"_at\d\((\w+), ([\d, ]+)\)", source)
         writes = re.findall(r"_set\d\((\w+), ([\d, ]+), ", source)
         assert reads and writes

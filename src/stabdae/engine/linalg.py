@@ -35,10 +35,10 @@ import math
 from functools import cache
 
 import numpy as np
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
 
-from .fma import HOST_FMA, _fused, _fused_negated, fma
+from .emit import emitted
+from .fma import fma
 from .jit import JIT
 from .source import exec_source
 from .sparsity import fill_pattern
@@ -342,70 +342,22 @@ def _solve_lines(n: int, at, L: tuple, b: tuple) -> tuple[list[str], tuple, int]
 
 
 def _written_out(header: str, lines: list[str], label: str):
+    """The straight-line function ``header`` + ``lines``, its entries held in locals
+    (:func:`_scalarized`), compiled: lowered by :func:`.emit.emitted` (no numba typing of
+    its statements) behind a one-line function that numba inlines where it is called
+    (callable from Python), whose ``emitted`` attribute is the intrinsic itself."""
     source = _scalarized(header + "\n" + "".join(f"    {line}\n" for line in lines or ["pass"]))
-    names = {"fma": _WRITTEN_FMA, "fnma": _WRITTEN_FNMA, **_ENTRY}
-    fn = exec_source(source, label, names)[header[4:header.index("(")]]
-    return njit(error_model="numpy", forceinline=True)(fn)
-
-
-def _entry_pointer(context, builder, aryty, ary, indices):
-    from numba.core import cgutils
-
-    array = context.make_array(aryty)(context, builder, ary)
-    inds = [context.cast(builder, i, t, types.intp) for i, t in indices]
-    return cgutils.get_item_pointer(context, builder, aryty, array, inds)
-
-
-def _load_intrinsic(ndim):
-    def typer(typingctx, a, *index):
-        if not (isinstance(a, types.Array) and a.ndim == ndim and len(index) == ndim
-                and all(isinstance(i, types.Integer) for i in index)):  # fmt: skip
-            return None
-
-        def codegen(context, builder, sig, args):
-            ptr = _entry_pointer(context, builder, sig.args[0], args[0],
-                                 list(zip(args[1:], sig.args[1:])))  # fmt: skip
-            return builder.load(ptr)
-
-        return a.dtype(a, *index), codegen
-
-    return typer
-
-
-def _store_intrinsic(ndim):
-    def typer(typingctx, a, *rest):
-        index, value = rest[:-1], rest[-1]
-        if not (isinstance(a, types.Array) and a.ndim == ndim and len(index) == ndim
-                and all(isinstance(i, types.Integer) for i in index)
-                and isinstance(value, (types.Float, types.Integer))):  # fmt: skip
-            return None
-
-        def codegen(context, builder, sig, args):
-            aryty = sig.args[0]
-            ptr = _entry_pointer(context, builder, aryty, args[0],
-                                 list(zip(args[1:-1], sig.args[1:-1])))  # fmt: skip
-            builder.store(context.cast(builder, args[-1], sig.args[-1], aryty.dtype), ptr)
-            return context.get_dummy_value()
-
-        return types.none(a, *rest), codegen
-
-    return typer
-
-
-def _at1(typingctx, a, i):
-    return _load_intrinsic(1)(typingctx, a, i)
-
-
-def _at2(typingctx, a, i, j):
-    return _load_intrinsic(2)(typingctx, a, i, j)
-
-
-def _set1(typingctx, a, i, v):
-    return _store_intrinsic(1)(typingctx, a, i, v)
-
-
-def _set2(typingctx, a, i, j, v):
-    return _store_intrinsic(2)(typingctx, a, i, j, v)
+    name, params = header[4:header.index("(")], header[header.index("(") + 1:header.index(")")]
+    fn = exec_source(source, label, {"fma": fma, "fnma": _fnma, **_PY_ENTRY})[name]
+    if not JIT:
+        return fn
+    wrapper = f"def {name}({params}):\n    return _emitted({params})\n"
+    emitted_ = emitted(ast.parse(source).body[0], {}, label)
+    call = exec_source(wrapper, label + "_call", {"_emitted": emitted_})[name]
+    out = njit(error_model="numpy", forceinline=True)(call)
+    out.straight_line = fn  # the Python function it does, for reading
+    out.emitted = emitted_  # for compiled callers: no function of its own to compile
+    return out
 
 
 def _py_at(a, *index):
@@ -416,35 +368,13 @@ def _py_set(a, *rest):
     a[rest[:-1]] = rest[-1]
 
 
-#: what the written-out code reads and writes an array's entry with: intrinsics (a load or
-#: a store at the entry's address, what indexing by constants compiles to) where the JIT
-#: runs, for numba types every subscript through each of its overloads of ``getitem`` and
-#: ``setitem``, at compiling and again at lowering, a few milliseconds a subscript
-if JIT:
-    _ENTRY = {"_at1": intrinsic(_at1), "_at2": intrinsic(_at2), "_set1": intrinsic(_set1),
-              "_set2": intrinsic(_set2)}  # fmt: skip
-else:
-    _ENTRY = {"_at1": _py_at, "_at2": _py_at, "_set1": _py_set, "_set2": _py_set}
-
-
-#: the written-out code's ``fma``: the fused multiply-add's intrinsic itself where there
-#: is one (the same instruction as :func:`.fma.fma`, which wraps it, without a function
-#: call per multiply-add for numba to type and lower: a tenth of a large factor's compile)
-_WRITTEN_FMA = _fused if (JIT and HOST_FMA) else fma
+#: the written-out Python code's entry reads and writes (what :func:`.emit.emitted` lowers
+#: to a load or a store at the entry's address)
+_PY_ENTRY = {"_at1": _py_at, "_at2": _py_at, "_set1": _py_set, "_set2": _py_set}
 
 
 def _fnma(a, b, c):
     return fma(-a, b, c)
-
-
-#: ... and its ``fnma(a, b, c)``, ``fma(-a, b, c)`` (most of a factor's and a solve's
-#: multiply-adds subtract: the negation inside the intrinsic is one statement less each)
-if JIT and HOST_FMA:
-    _WRITTEN_FNMA = _fused_negated
-elif JIT:
-    _WRITTEN_FNMA = njit(cache=True, forceinline=True, error_model="numpy")(_fnma)
-else:
-    _WRITTEN_FNMA = _fnma
 
 
 def _entry(node) -> tuple | None:

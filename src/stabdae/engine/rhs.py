@@ -41,8 +41,9 @@ from numba import njit
 
 from .._codes import LawKind, Status
 from .cache import Spec, fingerprint, memo, optional_fingerprint, tag
+from .emit import emitted_source
 from .fma import fma
-from .jit import python_function
+from .jit import JIT, python_function
 from .linalg import (
     UNROLL_MAX_OPS,
     _written_out,
@@ -163,10 +164,27 @@ def _rejit(fn, absent):
     into its callers and the workspace buffers it writes can live in registers.  (Not
     ``inline="always"``: inlining at the numba IR level re-types the caller for every
     call site and multiplied the ensemble kernel's compile time, see :mod:`.ensemble`.)
+    Straight-line code, such as ``stabdae generate`` writes, becomes an intrinsic of
+    :func:`.emit.emitted_source` instead (the same numbers, a fraction of numba's compile
+    time), callable from compiled code only.
     """
     if fn is None:
         return absent
-    return njit(error_model="numpy", forceinline=True)(python_function(fn))
+    pyfunc = python_function(fn)
+    if JIT:
+        # straight-line code (a generated model's) without numba's typing per statement,
+        # written into its callers (no function of its own for numba and LLVM to compile)
+        try:
+            return emitted_source(pyfunc, f"{pyfunc.__name__}_emitted")
+        except NotImplementedError:
+            pass  # numba compiles it as it is
+    return njit(error_model="numpy", forceinline=True)(pyfunc)
+
+
+def _inline(fn):
+    """The written-out routine ``fn`` (:func:`.linalg._written_out`) as the intrinsic that
+    writes it into its caller, where it has one; else ``fn``."""
+    return getattr(fn, "emitted", fn)
 
 
 def kernels_for(model, bound, multiplier: str = "ldl") -> Kernels:
@@ -524,6 +542,8 @@ def _build(model, spec: Spec) -> Kernels:
     factor_M, solve_M, solve_columns_M = (ldl_factor_for(n), ldl_solve_for(n),
                                           ldl_solve_columns_for(n, r))  # fmt: skip
     factor_S, solve_S, solve_Sm = ldl_factor_for(r), ldl_solve_for(r), ldl_solve_for(m)
+    factor_M, solve_M, solve_columns_M = map(_inline, (factor_M, solve_M, solve_columns_M))
+    factor_S, solve_S, solve_Sm = map(_inline, (factor_S, solve_S, solve_Sm))
     # the same, written out for the model's structural zeros where they pay (not for the
     # least-squares multiplier or the correction of Ascher et al., which read all of S)
     plan = None
@@ -531,10 +551,12 @@ def _build(model, spec: Spec) -> Kernels:
         plan = memo(model, Spec("structured"), lambda: _structured(model, n, m, k))
     STRUCTURED = plan is not None
     if STRUCTURED:
-        factor_S, solve_S = plan.factor_S, plan.solve_S
+        factor_S, solve_S = _inline(plan.factor_S), _inline(plan.solve_S)
         if HAS_MASS:
-            factor_M, solve_M, solve_columns_M = plan.factor_M, plan.solve_M, plan.solve_columns_M
-        load_Ft, gram, add_Fz, accel = plan.load_Ft, plan.gram, plan.add_Fz, plan.accel
+            factor_M, solve_M = _inline(plan.factor_M), _inline(plan.solve_M)
+            solve_columns_M = _inline(plan.solve_columns_M)
+        load_Ft, gram = _inline(plan.load_Ft), _inline(plan.gram)
+        add_Fz, accel = _inline(plan.add_Fz), _inline(plan.accel)
     else:  # never called (the branches on STRUCTURED are pruned), but typed
         load_Ft, gram, add_Fz, accel = _noop3, _noop4, _noop4, _noop5
 

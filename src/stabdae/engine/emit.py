@@ -1,0 +1,502 @@
+"""Straight-line numeric code compiled without numba's typing of every statement.
+
+A generated model's functions and the written-out linear algebra (:mod:`.linalg`,
+:mod:`.rhs`) are thousands of statements such as ``e12 = e3 * psi_dot`` or
+``s = fma(a, b, s)`` on array entries indexed by constants.  numba compiles such a
+function statement by statement: it types every operator and call by trying its overloads
+in turn, then looks them up again to lower them, one to a few milliseconds a statement,
+which made most of a coupled mechanism's first ensemble.  The types in such code follow
+from the arguments' alone, so :func:`emitted` types it in one pass of its own, asking
+numba's typing only once for each distinct operation and argument types (``float64 *
+float64``), and lowers it with numba's own implementations of those operations, called as
+numba's lowering calls them (the operands cast to the signature's types): the same
+instructions for LLVM, so the same numbers bit for bit.
+
+The accepted language is what the generators write:
+
+* statements: ``name = expr``, ``a, b = x, y``, ``array[i, j] = expr`` with constant
+  indices, ``array[:] = x`` and ``array[:, :] = x`` (every entry), ``name op= expr``, and a
+  ``return`` at the end;
+* expressions: names (arguments, earlier assignments, numbers and modules of the
+  function's globals), number constants, ``array[i, j]`` with constant non-negative
+  indices, ``+ - * / **``, unary ``-`` and ``+``, ``not``, ``&``, one comparison, and
+  calls of ``abs``, ``max``, ``min``, functions of :mod:`math` and compiled (``@njit``)
+  functions with fixed arguments.
+
+Anything else is refused (``NotImplementedError``) when the function is emitted, never
+guessed at; the caller then compiles the function with numba as it is.
+"""
+
+from __future__ import annotations
+
+import ast
+import builtins
+import inspect
+import math
+import operator
+import textwrap
+import types as pytypes
+
+from numba import types
+from numba.core import cgutils
+from numba.core.dispatcher import Dispatcher
+from numba.extending import intrinsic
+
+from .fma import HOST_FMA
+
+__all__ = ["emitted", "emitted_source"]
+
+
+class _Refused(NotImplementedError):
+    pass
+
+
+_BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+           ast.Div: operator.truediv, ast.Pow: operator.pow, ast.BitAnd: operator.and_}
+_INPLACE = {ast.Add: operator.iadd, ast.Sub: operator.isub, ast.Mult: operator.imul,
+            ast.Div: operator.itruediv}
+_UNARY = {ast.USub: operator.neg, ast.UAdd: operator.pos, ast.Not: operator.not_}
+_COMPARE = {ast.Gt: operator.gt, ast.Lt: operator.lt, ast.GtE: operator.ge,
+            ast.LtE: operator.le, ast.Eq: operator.eq, ast.NotEq: operator.ne}  # fmt: skip
+_SYNTAX = (ast.FunctionDef, ast.arguments, ast.arg, ast.Assign, ast.AugAssign, ast.Expr,
+           ast.Return, ast.Pass, ast.Name, ast.Load, ast.Store, ast.Constant, ast.Call,
+           ast.BinOp, ast.UnaryOp, ast.Compare, ast.Subscript, ast.Tuple, ast.Slice,
+           ast.Attribute, *_BINARY, *_UNARY, *_COMPARE)  # fmt: skip
+#: the written-out linear algebra's own functions (:mod:`.linalg`), by name
+_SPECIAL = {"fma": 3, "fnma": 3, "_at1": 2, "_at2": 3, "_set1": 3, "_set2": 4}
+
+#: numba's signature for each operation and argument types met so far
+_SIGNATURES: dict = {}
+
+
+def _signature(typingctx, fn, argtypes):
+    key = (fn, argtypes)
+    sig = _SIGNATURES.get(key)
+    if sig is None:
+        fnty = typingctx.resolve_value_type(fn)
+        sig = typingctx.resolve_function_type(fnty, argtypes, {})
+        if sig is None:
+            raise _Refused(f"numba has no {getattr(fn, '__name__', fn)}{argtypes}")
+        _SIGNATURES[key] = sig
+    return sig
+
+
+def _constant_type(typingctx, value):
+    """A constant's type as numba's type inference gives it: Literal[int](2), float64."""
+    return types.maybe_literal(value) or typingctx.resolve_value_type(value)
+
+
+def _fold(node):
+    """Number constants folded as CPython folds them before numba sees the bytecode
+    (``-2.0``, ``2 * 3``): the same constants, typed as numba types them."""
+
+    class Fold(ast.NodeTransformer):
+        def visit_UnaryOp(self, node):
+            node = self.generic_visit(node)
+            if (isinstance(node.op, (ast.USub, ast.UAdd)) and isinstance(node.operand, ast.Constant)
+                    and type(node.operand.value) in (int, float)):  # fmt: skip
+                value = node.operand.value
+                return ast.copy_location(ast.Constant(-value if isinstance(node.op, ast.USub)
+                                                      else +value), node)  # fmt: skip
+            return node
+
+    return ast.fix_missing_locations(Fold().visit(node))
+
+
+class _Function:
+    """A straight-line function checked against the language, with what its names mean."""
+
+    def __init__(self, fn_def: ast.FunctionDef, namespace: dict, fused: bool):
+        self.fn_def, self.namespace, self.fused = _fold(fn_def), namespace, fused
+        self.params = [a.arg for a in fn_def.args.args]
+        a = fn_def.args
+        if a.vararg or a.kwarg or a.kwonlyargs or a.defaults or a.posonlyargs:
+            raise _Refused(f"{fn_def.name}'s arguments")
+        body = list(self.fn_def.body)
+        while body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+            body = body[1:]  # a docstring
+        self.ret = body.pop() if body and isinstance(body[-1], ast.Return) else None
+        self.body = body
+        for node in ast.walk(self.fn_def):
+            nested = node is not self.fn_def and isinstance(node, ast.FunctionDef)
+            if nested or not isinstance(node, _SYNTAX):
+                raise _Refused(f"{type(node).__name__} in {fn_def.name}")
+        defined = set(self.params)
+        self.assigned = {n.id for n in ast.walk(self.fn_def) if isinstance(n, ast.Name)
+                         and isinstance(n.ctx, ast.Store)}  # fmt: skip
+        for stmt in body:
+            self._check_statement(stmt, defined)
+        if self.ret is not None and self.ret.value is not None:
+            self._check_expr(self.ret.value, defined)
+
+    def refuse(self, node):
+        raise _Refused(f"{ast.unparse(node)} in {self.fn_def.name}")
+
+    def global_(self, name):
+        if name in self.namespace:
+            return self.namespace[name]
+        if hasattr(builtins, name):
+            return getattr(builtins, name)
+        raise _Refused(f"the name {name} in {self.fn_def.name}")
+
+    def resolve(self, node):
+        """The object a global name or a module's attribute stands for."""
+        if isinstance(node, ast.Name):
+            return self.global_(node.id)
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+            module = self.global_(node.value.id)
+            if isinstance(module, pytypes.ModuleType) and hasattr(module, node.attr):
+                return getattr(module, node.attr)
+        self.refuse(node)
+
+    def callee(self, call):
+        if isinstance(call.func, ast.Name) and call.func.id in _SPECIAL and (
+                call.func.id not in self.namespace):  # fmt: skip
+            return call.func.id
+        fn = self.resolve(call.func)
+        of_math = isinstance(fn, pytypes.BuiltinFunctionType) and (
+            fn is getattr(math, fn.__name__, None))  # fmt: skip
+        if fn in (abs, max, min) or isinstance(fn, Dispatcher) or of_math:
+            return fn
+        self.refuse(call)
+
+    def constant(self, node):
+        """The number a name or attribute of the globals stands for, else None."""
+        if isinstance(node, ast.Constant) and type(node.value) in (int, float, bool):
+            return node.value
+        if isinstance(node, (ast.Name, ast.Attribute)):
+            try:
+                value = self.resolve(node)
+            except _Refused:
+                return None
+            if type(value) in (int, float, bool):
+                return value
+        return None
+
+    def _check_expr(self, node, defined):
+        if isinstance(node, ast.Name) and node.id in defined:
+            return
+        if isinstance(node, ast.Name) and node.id in self.assigned:
+            self.refuse(node)  # read before it is assigned
+        if self.constant(node) is not None:
+            return
+        if isinstance(node, ast.Subscript):
+            self._entry(node, defined, store=False)
+        elif isinstance(node, ast.BinOp):
+            if isinstance(node.op, ast.Pow) and not (isinstance(node.right, ast.Constant)
+                                                     and type(node.right.value) in (int, float)):
+                self.refuse(node)  # (numba may lower ``x ** c`` by c's value one day)
+            self._check_expr(node.left, defined)
+            self._check_expr(node.right, defined)
+        elif isinstance(node, ast.UnaryOp):
+            self._check_expr(node.operand, defined)
+        elif isinstance(node, ast.Compare) and len(node.ops) == 1:
+            self._check_expr(node.left, defined)
+            self._check_expr(node.comparators[0], defined)
+        elif isinstance(node, ast.Call) and not node.keywords:
+            fn = self.callee(node)
+            if (_SPECIAL.get(fn, len(node.args)) != len(node.args)
+                    or (fn in (max, min) and len(node.args) != 2)):  # fmt: skip
+                self.refuse(node)
+            if fn in ("_set1", "_set2"):
+                self.refuse(node)  # a statement, not a value
+            if fn in ("_at1", "_at2"):
+                self._array(node.args[0], defined)
+                self._indices(node, node.args[1:], int(fn[-1]))
+            else:
+                for arg in node.args:
+                    self._check_expr(arg, defined)
+        else:
+            self.refuse(node)
+
+    def _array(self, node, defined):
+        if not (isinstance(node, ast.Name) and node.id in self.params):
+            self.refuse(node)
+
+    def _indices(self, node, index, ndim=None):
+        if not all(isinstance(i, ast.Constant) and type(i.value) is int and i.value >= 0
+                   for i in index) or (ndim is not None and len(index) != ndim):  # fmt: skip
+            self.refuse(node)
+
+    def _entry(self, node, defined, store):
+        self._array(node.value, defined)
+        index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+        if store and all(isinstance(i, ast.Slice) and i.lower is None and i.upper is None
+                         and i.step is None for i in index):  # fmt: skip
+            return "fill"
+        self._indices(node, index)
+        return "entry"
+
+    def _check_statement(self, stmt, defined):
+        if isinstance(stmt, ast.Pass):
+            return
+        if isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Call) and isinstance(
+                stmt.value.func, ast.Name) and stmt.value.func.id in ("_set1", "_set2") and (
+                self.callee(stmt.value) in ("_set1", "_set2")):  # fmt: skip
+            call = stmt.value
+            if len(call.args) != _SPECIAL[call.func.id]:
+                self.refuse(stmt)
+            self._array(call.args[0], defined)
+            self._indices(call, call.args[1:-1], int(call.func.id[-1]))
+            self._check_expr(call.args[-1], defined)
+            return
+        if isinstance(stmt, ast.AugAssign) and isinstance(stmt.target, ast.Name) and (
+                type(stmt.op) in _INPLACE and stmt.target.id in defined
+                and stmt.target.id not in self.params):  # fmt: skip
+            self._check_expr(stmt.value, defined)
+            return
+        if not (isinstance(stmt, ast.Assign) and len(stmt.targets) == 1):
+            self.refuse(stmt)
+        target, value = stmt.targets[0], stmt.value
+        if isinstance(target, ast.Tuple):
+            if not (isinstance(value, ast.Tuple) and len(value.elts) == len(target.elts)
+                    and all(isinstance(t, ast.Name) for t in target.elts)):  # fmt: skip
+                self.refuse(stmt)
+            values = value.elts
+        else:
+            values = [value]
+        for v in values:
+            self._check_expr(v, defined)
+        if isinstance(target, ast.Subscript):
+            if self._entry(target, defined, store=True) == "fill" and (
+                    self.constant(value) is None and not (
+                    isinstance(value, ast.Name) and value.id in defined)):  # fmt: skip
+                self.refuse(stmt)
+            return
+        for t in (target.elts if isinstance(target, ast.Tuple) else [target]):
+            if not isinstance(t, ast.Name) or t.id in self.params:
+                self.refuse(stmt)
+            defined.add(t.id)
+
+
+class _Typing:
+    """The numba types of a :class:`_Function`'s values for given argument types, and the
+    signatures of its operations (by node), as numba's type inference would find them."""
+
+    def __init__(self, fn: _Function, typingctx, argtypes):
+        self.fn, self.tc = fn, typingctx
+        self.names = dict(zip(fn.params, argtypes))
+        self.sigs: dict = {}  # id(node) -> numba signature
+        for name, t in self.names.items():
+            if isinstance(t, types.Array) and t.dtype != types.float64:
+                raise _Refused(f"an array of {t.dtype} for {name}")
+        for stmt in fn.body:
+            self.statement(stmt)
+        ret = fn.ret.value if fn.ret is not None else None
+        self.restype = types.none if ret is None else types.unliteral(self.expr(ret))
+        self.names = None  # only the signatures are kept
+
+    def op(self, node, fn, argtypes):
+        sig = _signature(self.tc, fn, tuple(argtypes))
+        self.sigs[id(node)] = sig
+        return sig.return_type
+
+    def expr(self, node):
+        fn = self.fn
+        if isinstance(node, ast.Name) and node.id in self.names:
+            return self.names[node.id]
+        value = fn.constant(node)
+        if value is not None:
+            return _constant_type(self.tc, value)
+        if isinstance(node, ast.Subscript):
+            return self.names[node.value.id].dtype
+        if isinstance(node, ast.BinOp):
+            left, right = self.expr(node.left), self.expr(node.right)
+            return self.op(node, _BINARY[type(node.op)], (left, right))
+        if isinstance(node, ast.UnaryOp):
+            return self.op(node, _UNARY[type(node.op)], (self.expr(node.operand),))
+        if isinstance(node, ast.Compare):
+            return self.op(node, _COMPARE[type(node.ops[0])],
+                           (self.expr(node.left), self.expr(node.comparators[0])))  # fmt: skip
+        if isinstance(node, ast.Call):
+            callee = fn.callee(node)
+            if callee in ("_at1", "_at2"):
+                return self.names[node.args[0].id].dtype
+            args = [self.expr(a) for a in node.args]
+            if callee in ("fma", "fnma"):
+                return types.float64
+            if callee in (max, min):  # numba's max of two floats, written out (below)
+                if not all(isinstance(a, types.Float) for a in args):
+                    raise _Refused(f"{ast.unparse(node)} of {args}")
+                return types.float64
+            return self.op(node, callee, args)
+        raise _Refused(ast.unparse(node))
+
+    def statement(self, stmt):
+        if isinstance(stmt, ast.Expr):  # _set1, _set2
+            self.expr(stmt.value.args[-1])
+            return
+        if isinstance(stmt, ast.AugAssign):
+            name = stmt.target.id
+            self.names[name] = self.op(stmt, _INPLACE[type(stmt.op)],
+                                       (self.names[name], self.expr(stmt.value)))  # fmt: skip
+            return
+        if isinstance(stmt, ast.Pass):
+            return
+        target, value = stmt.targets[0], stmt.value
+        if isinstance(target, ast.Tuple):
+            values = [self.expr(v) for v in value.elts]
+            for t, v in zip(target.elts, values):
+                self.names[t.id] = v
+        elif isinstance(target, ast.Subscript):
+            self.expr(value)
+        else:
+            self.names[target.id] = self.expr(value)
+
+
+class _Lowering:
+    """A :class:`_Function` written into ``builder`` with its :class:`_Typing`: every
+    value a pair ``(numba type, llvm value)``."""
+
+    def __init__(self, fn: _Function, typing: _Typing, context, builder, argtypes, args):
+        self.fn, self.sigs, self.context, self.builder = fn, typing.sigs, context, builder
+        self.names = {p: (t, v) for p, t, v in zip(fn.params, argtypes, args)}
+
+    def cast(self, value, to):
+        t, v = value
+        return self.context.cast(self.builder, v, t, to)
+
+    def call_impl(self, node, fn, args):
+        """numba's implementation of ``fn`` at ``node``'s signature, the operands cast to
+        its argument types."""
+        sig = self.sigs[id(node)]
+        fnty = self.context.typing_context.resolve_value_type(fn)
+        impl = self.context.get_function(fnty, sig)
+        vals = [self.cast(a, t) for a, t in zip(args, sig.args)]
+        return sig.return_type, impl(self.builder, vals)
+
+    def pointer(self, array_node, index):
+        aryty, ary = self.names[array_node.id]
+        array = self.context.make_array(aryty)(self.context, self.builder, ary)
+        idx = [self.context.get_constant(types.intp, i) for i in index]
+        return aryty, cgutils.get_item_pointer(self.context, self.builder, aryty, array, idx)
+
+    def constant(self, value):
+        t = _constant_type(self.context.typing_context, value)
+        return t, self.context.get_constant(types.unliteral(t), value)
+
+    def expr(self, node):
+        fn, b = self.fn, self.builder
+        if isinstance(node, ast.Name) and node.id in self.names:
+            return self.names[node.id]
+        value = fn.constant(node)
+        if value is not None:
+            return self.constant(value)
+        if isinstance(node, ast.Subscript):
+            index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+            aryty, ptr = self.pointer(node.value, [i.value for i in index])
+            return aryty.dtype, b.load(ptr)
+        if isinstance(node, ast.BinOp):
+            left, right = self.expr(node.left), self.expr(node.right)
+            return self.call_impl(node, _BINARY[type(node.op)], (left, right))
+        if isinstance(node, ast.UnaryOp):
+            return self.call_impl(node, _UNARY[type(node.op)], (self.expr(node.operand),))
+        if isinstance(node, ast.Compare):
+            return self.call_impl(node, _COMPARE[type(node.ops[0])],
+                                  (self.expr(node.left), self.expr(node.comparators[0])))
+        callee = fn.callee(node)
+        if callee in ("_at1", "_at2"):
+            aryty, ptr = self.pointer(node.args[0], [i.value for i in node.args[1:]])
+            return aryty.dtype, b.load(ptr)
+        args = [self.expr(a) for a in node.args]
+        if callee in ("fma", "fnma"):
+            x, y, z = (self.cast(a, types.float64) for a in args)
+            x = b.fneg(x) if callee == "fnma" else x
+            if fn.fused:
+                return types.float64, b.fma(x, y, z)  # llvm.fma.f64, as :func:`.fma.fma`
+            return types.float64, b.fadd(b.fmul(x, y), z)  # as :func:`.fma.fma` without FMA
+        if callee in (max, min):
+            # numba's max and min of two floats: ``y if y > x else x`` (Python's order)
+            (_, x), (_, y) = (( types.float64, self.cast(a, types.float64)) for a in args)
+            pick = b.fcmp_ordered(">" if callee is max else "<", y, x)
+            return types.float64, b.select(pick, y, x)
+        return self.call_impl(node, callee, args)
+
+    def store(self, target, value):
+        index = target.slice.elts if isinstance(target.slice, ast.Tuple) else [target.slice]
+        aryty, ary = self.names[target.value.id]
+        v = self.cast(value, aryty.dtype)
+        if isinstance(index[0], ast.Slice):  # every entry
+            array = self.context.make_array(aryty)(self.context, self.builder, ary)
+            shape = cgutils.unpack_tuple(self.builder, array.shape, aryty.ndim)
+            intp = self.context.get_value_type(types.intp)
+            with cgutils.loop_nest(self.builder, shape, intp) as idx:
+                ptr = cgutils.get_item_pointer(self.context, self.builder, aryty, array, idx)
+                self.builder.store(v, ptr)
+            return
+        _, ptr = self.pointer(target.value, [i.value for i in index])
+        self.builder.store(v, ptr)
+
+    def statement(self, stmt):
+        if isinstance(stmt, ast.Pass):
+            return
+        if isinstance(stmt, ast.Expr):  # _set1, _set2
+            call = stmt.value
+            aryty, ptr = self.pointer(call.args[0], [i.value for i in call.args[1:-1]])
+            self.builder.store(self.cast(self.expr(call.args[-1]), aryty.dtype), ptr)
+            return
+        if isinstance(stmt, ast.AugAssign):
+            name = stmt.target.id
+            self.names[name] = self.call_impl(stmt, _INPLACE[type(stmt.op)],
+                                              (self.names[name], self.expr(stmt.value)))
+            return
+        target, value = stmt.targets[0], stmt.value
+        if isinstance(target, ast.Tuple):
+            values = [self.expr(v) for v in value.elts]
+            for t, v in zip(target.elts, values):
+                self.names[t.id] = v
+        elif isinstance(target, ast.Subscript):
+            self.store(target, self.expr(value))
+        else:
+            self.names[target.id] = self.expr(value)
+
+
+def emitted(fn_def: ast.FunctionDef, namespace: dict, label: str, fused: bool = HOST_FMA):
+    """An intrinsic named ``label`` doing what the straight-line function ``fn_def`` does
+    with the globals ``namespace`` (see the module docstring for the language); raises
+    NotImplementedError for code outside that language.  ``fused``: whether the written-out
+    linear algebra's ``fma`` is the fused multiply-add (else ``a * b + c``, as
+    :func:`.fma.fma` on a CPU without one)."""
+    fn = _Function(fn_def, namespace, fused)
+    typings: dict = {}  # argument types -> _Typing
+
+    def typer(typingctx, *argtypes):
+        if len(argtypes) != len(fn.params):
+            return None
+        if argtypes not in typings:
+            typings[argtypes] = _Typing(fn, typingctx, argtypes)
+        typing = typings[argtypes]
+
+        def codegen(context, builder, sig, args):
+            lowering = _Lowering(fn, typing, context, builder, sig.args, args)
+            for stmt in fn.body:
+                lowering.statement(stmt)
+            if fn.ret is None or fn.ret.value is None:
+                return context.get_dummy_value()
+            return lowering.cast(lowering.expr(fn.ret.value), sig.return_type)
+
+        return typing.restype(*argtypes), codegen
+
+    # numba reads the typer's parameters for the intrinsic's (a ``*args`` typer would be
+    # called with one tuple): one explicit parameter per argument
+    names = ", ".join(fn.params)
+    spelled = {"_typer": typer}
+    exec(f"def {label}(typingctx, {names}):\n    return _typer(typingctx, {names})\n", spelled)
+    return intrinsic(spelled[label])
+
+
+def emitted_source(pyfunc, label: str):
+    """``pyfunc`` (a plain Python function, such as a model's) as an intrinsic of
+    :func:`emitted` (called from compiled code only); raises NotImplementedError where its
+    code is outside the language, its source cannot be read, or it has free variables."""
+    if pyfunc.__code__.co_freevars:
+        raise _Refused(f"{pyfunc.__name__} has free variables")
+    try:
+        source = textwrap.dedent(inspect.getsource(pyfunc))
+    except (OSError, TypeError) as exc:
+        raise _Refused(f"no source for {pyfunc.__name__}") from exc
+    fn_def = ast.parse(source).body[0]
+    if not isinstance(fn_def, ast.FunctionDef):
+        raise _Refused(f"{pyfunc.__name__} is not a function definition")
+    fn_def.decorator_list = []
+    return emitted(fn_def, pyfunc.__globals__, label)
