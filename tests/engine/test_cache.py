@@ -513,3 +513,32 @@ def test_compile_seconds_counts_the_compiling_of_a_new_function_and_nothing_else
     before, clock = compile_seconds(), time.perf_counter()
     fresh(3_000_000)
     assert compile_seconds() - before < 0.01 * max(time.perf_counter() - clock, 0.01)
+
+
+@pytest.mark.skipif(not stabdae.engine.jit.JIT, reason="numba's wrappers: needs the JIT")
+def test_an_internal_function_has_no_wrappers_and_python_calls_reach_its_twin():
+    """A kernel's piece compiled without numba's CPython and C wrappers: compiled callers
+    call it; a call from Python (which would jump into a wrapper that is not there) goes
+    to a twin compiled with them, made once; the piece's own compilation has neither."""
+    from stabdae.engine.jit import from_python, internal
+
+    @internal(error_model="numpy")
+    def piece(x, out):
+        out[0] = 2.0 * x
+        return out[0] + 1.0
+
+    @njit
+    def caller(x):
+        out = np.zeros(1)
+        return piece(x, out)
+
+    assert caller(3.0) == 7.0
+    (sig,) = piece.signatures
+    library = piece.overloads[sig].library
+    assert "cpython" not in library.get_llvm_str() and "cfunc" not in library.get_llvm_str()
+    out = np.zeros(1)
+    assert piece(4.0, out) == 9.0 and out[0] == 8.0  # from Python: the twin
+    twin = from_python(piece)
+    assert twin is from_python(piece) and twin is not piece
+    assert "cpython" in twin.overloads[twin.signatures[0]].library.get_llvm_str()
+    assert from_python(caller) is caller  # anything else: itself

@@ -13,11 +13,12 @@ import inspect
 import threading
 import time
 
-from numba import config
+from numba import config, njit
 from numba.core import event
 from numba.core.dispatcher import Dispatcher
+from numba.core.registry import CPUDispatcher
 
-__all__ = ["JIT", "compile_seconds", "is_njit", "python_function"]
+__all__ = ["JIT", "compile_seconds", "from_python", "internal", "is_njit", "python_function"]
 
 #: False when numba's JIT is switched off (``NUMBA_DISABLE_JIT=1``)
 JIT = not config.DISABLE_JIT
@@ -32,6 +33,44 @@ def is_njit(fn) -> bool:
 def python_function(fn):
     """The Python function behind a dispatcher (the function itself without the JIT)."""
     return getattr(fn, "py_func", fn)
+
+
+def internal(**options):
+    """``njit(**options)`` for a function that compiled code calls (a kernel's pieces):
+    numba then builds neither its CPython nor its C wrapper, code that boxes and unboxes
+    every argument (a workspace is a tuple of arrays) and goes through LLVM with the rest,
+    about a second of a model's first ensemble over the pieces.  A call from Python goes
+    to its twin with the wrappers, compiled when first called (:func:`from_python`)."""
+    decorate = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True, **options)
+
+    def make(fn):
+        dispatcher = decorate(fn)
+        if JIT:
+            dispatcher.__class__ = _Internal
+        return dispatcher
+
+    return make
+
+
+def from_python(fn):
+    """``fn`` callable from Python: for a dispatcher of :func:`internal`, a twin compiled
+    with the same options and its wrappers (made once); anything else as it is."""
+    if not isinstance(fn, _Internal):
+        return fn
+    twin = fn.__dict__.get("_from_python")
+    if twin is None:
+        kept = {k: v for k, v in fn.targetoptions.items()
+                if k not in ("no_cpython_wrapper", "no_cfunc_wrapper", "nopython")}  # fmt: skip
+        twin = fn.__dict__["_from_python"] = njit(**kept)(fn.py_func)
+    return twin
+
+
+class _Internal(CPUDispatcher):
+    """A dispatcher of :func:`internal`: compiled code calls it as any other; a call from
+    Python (which would jump into the wrapper it does not have) goes to its twin."""
+
+    def __call__(self, *args, **kwargs):
+        return from_python(self)(*args, **kwargs)
 
 
 class _CompileClock(event.Listener):

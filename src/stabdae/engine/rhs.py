@@ -43,7 +43,7 @@ from .._codes import LawKind, Status
 from .cache import Spec, fingerprint, memo, optional_fingerprint, tag
 from .emit import emitted_source
 from .fma import fma
-from .jit import JIT, python_function
+from .jit import JIT, internal, python_function
 from .linalg import (
     UNROLL_MAX_OPS,
     _written_out,
@@ -291,7 +291,7 @@ def _pieces(model, sparse: bool) -> Pieces:
         FPTR = FCOL = CPTR = CROW = HQPTR = HQCOL = SI = SC = SPTR = SJ = _NO_INDEX
         LPTR = LCOL = OPTR = OQ = LTPTR = LROW = _NO_INDEX
 
-    @njit(forceinline=True, error_model="numpy")
+    @internal(forceinline=True, error_model="numpy")
     def sparse_Y(t, q, p, ws, rows):
         """The sparse path's ``Y = M⁻¹ Fᵀ`` for the first ``rows`` rows of ``F`` (M
         diagonal, its inverse left on the diagonal of ``ws.M``, or absent); whether M's
@@ -309,7 +309,7 @@ def _pieces(model, sparse: bool) -> Pieces:
                     Y[j, i] = fij * Mw[j, j] if HAS_MASS else fij
         return bad
 
-    @njit(forceinline=True, error_model="numpy")
+    @internal(forceinline=True, error_model="numpy")
     def sparse_S(ws, rows):
         """The sparse path's ``S = F Y`` on its factor's pattern (the fill starts from
         zero) and its L D Lᵀ factor, for the first ``rows`` rows of F (the leading block's
@@ -327,7 +327,7 @@ def _pieces(model, sparse: bool) -> Pieces:
                 S[i, c] = s
         return ldl_sparse_inplace(S, rows, S_RTOL, LPTR, LCOL, OPTR, OQ) != 0
 
-    @njit(forceinline=True)
+    @internal(forceinline=True)
     def residual(t, x, p, ws, g):
         """g = (f, f_q v + f_t, h) of (3.2) into ``g``; fills ws q, v, f_q, h_v, h_q."""
         q, v, fq, hv, hq, sm, sk = ws.q, ws.v, ws.fq, ws.hv, ws.hq, ws.sm, ws.sk
@@ -358,7 +358,7 @@ def _pieces(model, sparse: bool) -> Pieces:
             h_v(t, q, v, p, hv)
             h_q(t, q, v, p, hq)
 
-    @njit(error_model="numpy")
+    @internal(error_model="numpy")
     def project(t, x, p, ws, sweeps, tol):
         """Move ``x`` onto (towards) the manifold ``g = 0``, in place; return a status.
 
@@ -422,7 +422,7 @@ def _pieces(model, sparse: bool) -> Pieces:
                     x[level * n + j] -= s
         return _OK
 
-    @njit(error_model="numpy")
+    @internal(error_model="numpy")
     def energy(t, x, p, ws):
         q, v = ws.q, ws.v
         for i in range(n):
@@ -560,7 +560,7 @@ def _build(model, spec: Spec) -> Kernels:
     else:  # never called (the branches on STRUCTURED are pruned), but typed
         load_Ft, gram, add_Fz, accel = _noop3, _noop4, _noop4, _noop5
 
-    @njit(forceinline=True, error_model="numpy")
+    @internal(forceinline=True, error_model="numpy")
     def rhs(t, x, p, law_mat, law_scal, ws, xdot):
         """Write ẋ of the stabilized system (3.1) into ``xdot``; return a status code.
 

@@ -23,6 +23,7 @@ from scipy.special import ndtri
 
 from .._codes import Status
 from .cache import Spec, keyed_cache, memo, tag
+from .jit import internal
 from .linalg import ldl_inplace, ldl_solve_inplace
 from .rhs import LAW_CONSTANT, kernels_for
 
@@ -68,7 +69,7 @@ def build_sampler(K, spec: Spec):
     eps3 = np.finfo(np.float64).eps ** (1.0 / 3.0)
     eps = np.finfo(np.float64).eps
 
-    @njit(error_model="numpy")
+    @internal(error_model="numpy")
     def jacobian(x, t0, p, ws, xp, gpm, G, GGt):
         """``G = ∂g/∂x`` at ``x`` by central differences and the L D Lᵀ factor of
         ``G Gᵀ`` into ``GGt``; whether the factorization failed."""

@@ -26,6 +26,7 @@ from numba import config, njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from .jit import internal
 from .source import exec_source
 
 __all__ = ["LAYOUT", "Workspace", "builders", "copy_inputs", "copy_tableau", "sizes", "stack1",
@@ -92,7 +93,7 @@ def builders(n: int, m: int, k: int):
     ns = exec_source(_builder_source(n, m, k), f"workspace_n{n}_m{m}_k{k}",
                      {"np": np, "Workspace": Workspace, "stack1": stack1,
                       "stack2": stack2})  # fmt: skip
-    return (njit(error_model="numpy")(ns["make_workspace"]),
+    return (internal(error_model="numpy")(ns["make_workspace"]),
             njit(inline="always")(ns["stack_workspace"]))  # fmt: skip
 
 

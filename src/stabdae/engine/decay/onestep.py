@@ -9,6 +9,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..jit import internal
 from ..workspace import stack1
 from .fit import FLOOR_MARGIN, MIN_DECADES, MIN_POINTS
 from .ladder import _TINY, LEVELS_PER_OCTAVE, NBINS, ladder_level, log_normal, trailing_zeros
@@ -279,7 +280,7 @@ def pairs_full_for(B: int, ng: int):
     checked their arrays for overlap at run time (slower; studies/README.md has the
     figures)."""
 
-    @njit(forceinline=True, error_model="numpy")
+    @internal(forceinline=True, error_model="numpy")
     def pairs_full(Dv, P, A, w):
         c = 0
         for r in range(ng):
@@ -311,7 +312,7 @@ def flushes_for(FULL: int):
     if not FULL:
         return bin_flush, end_flush
 
-    @njit(forceinline=True)
+    @internal(forceinline=True)
     def _store_full(S, A, j, bin_):
         c = 0
         for r in range(FULL):
@@ -325,7 +326,7 @@ def flushes_for(FULL: int):
             c += 1
         S[j, bin_, 2 * FULL * FULL] = A[c, j]
 
-    @njit(error_model="numpy")
+    @internal(error_model="numpy")
     def bin_flush_full(S, A, nlev, low, mask, pooled, full):
         while mask != 0:
             j = trailing_zeros(mask)
@@ -335,7 +336,7 @@ def flushes_for(FULL: int):
                 _store_full(S, A, j, b)
             low[j] = nb
 
-    @njit(error_model="numpy")
+    @internal(error_model="numpy")
     def end_flush_full(S, A, low, active, pooled, full):
         for j in range(low.shape[0]):
             if active[j]:

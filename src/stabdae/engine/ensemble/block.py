@@ -80,6 +80,7 @@ from ..decay import (
     spectral_radius_of,
     windows_flush,
 )
+from ..jit import internal
 from ..rhs import kernels_for
 from ..rk.steps import _member_step, tableau_pattern
 from ..workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
@@ -265,7 +266,7 @@ def build_block_kernel(K, spec: Spec):
     bin_flush, end_flush = flushes_for(FULL if pooled < 0 else 0)
     NA = 10 if pooled >= 0 else ROWS_FULL  # rows of the current bin visit's sums
 
-    @njit(error_model="numpy")
+    @internal(error_model="numpy")
     def block_norms(X, t, p, gref, nrm, dnrm, G):
         """``‖g‖∞`` and ``‖g − gref‖∞`` of every slot of the block at time ``t`` into
         ``nrm`` and ``dnrm``, and ``g`` into the columns of ``G``: one loop over the

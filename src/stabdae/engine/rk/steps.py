@@ -33,6 +33,7 @@ from numba import njit
 from ..._codes import Status
 from ..cache import Spec, keyed_cache, memo
 from ..fma import fma
+from ..jit import internal
 from ..rhs import kernels_for
 from ..source import exec_source
 from ..workspace import stack1, stack2
@@ -63,7 +64,7 @@ def sample_writer(K):
     residual, energy = K.residual, K.energy
     N2, ng = 2 * K.n, K.ng
 
-    @njit(forceinline=True)
+    @internal(forceinline=True)
     def save(j, t, x, p, ws, g, out_x, out_g, out_e):
         residual(t, x, p, ws, g)
         for l in range(N2):
