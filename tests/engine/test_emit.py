@@ -33,7 +33,7 @@ def f(a, b, k, x):
     m = abs(a[1, 0])
     m = max(m, abs(u))
     m = min(m, x) + max(x, -2.0)
-    q = 1.0 / w + k / 3
+    q = 1.0 / w + k / 3 + 2 ** -1 * x - (3 - 1) ** 2 * 1e-3
     r = -q * t + m - u ** 2 + abs(t) ** 1.5 + SCALE * math.sqrt(abs(q))
     r *= 2.0
     r += simdmath.sin(t) * math.cos(u)

@@ -5,8 +5,10 @@ codes instead of raising.  They import NumPy and Numba but never xarray, never a
 the floors above (not even for annotations), and never validate user input (the drivers
 one floor up do, once).  By role:
 
-* :mod:`.jit`, :mod:`.fma`, :mod:`.source` — whether the JIT runs, the fused multiply-add,
-  generated source registered for tracebacks;
+* :mod:`.jit`, :mod:`.fma`, :mod:`.source`, :mod:`.emit` — whether the JIT runs (and
+  functions compiled without wrappers for compiled callers), the fused multiply-add,
+  generated source registered for tracebacks, straight-line code compiled without
+  numba's typing of each statement;
 * :mod:`.linalg`, :mod:`.sparsity` — allocation-free L D Lᵀ (looped, and written out for
   a model's sizes and patterns); the sparse right-hand side's index lists;
 * :mod:`.workspace` — the right-hand side's buffers, declared once by name, built on the

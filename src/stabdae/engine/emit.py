@@ -100,6 +100,21 @@ def _fold(node):
                                                       else +value), node)  # fmt: skip
             return node
 
+        def visit_BinOp(self, node):
+            node = self.generic_visit(node)
+            a, b = node.left, node.right
+            if not (type(node.op) in _BINARY and isinstance(a, ast.Constant)
+                    and isinstance(b, ast.Constant) and type(a.value) in (int, float)
+                    and type(b.value) in (int, float)):  # fmt: skip
+                return node
+            try:
+                value = _BINARY[type(node.op)](a.value, b.value)
+            except (ArithmeticError, TypeError, ValueError):
+                return node  # (CPython leaves it to run time too)
+            if type(value) not in (int, float) or (type(value) is int and abs(value) >= 2**63):
+                return node
+            return ast.copy_location(ast.Constant(value), node)
+
     return ast.fix_missing_locations(Fold().visit(node))
 
 
