@@ -422,7 +422,7 @@ class _Lowering:
             return types.float64, b.fadd(b.fmul(x, y), z)  # as :func:`.fma.fma` without FMA
         if callee in (max, min):
             # numba's max and min of two floats: ``y if y > x else x`` (Python's order)
-            (_, x), (_, y) = (( types.float64, self.cast(a, types.float64)) for a in args)
+            x, y = (self.cast(a, types.float64) for a in args)
             pick = b.fcmp_ordered(">" if callee is max else "<", y, x)
             return types.float64, b.select(pick, y, x)
         return self.call_impl(node, callee, args)
