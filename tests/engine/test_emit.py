@@ -190,3 +190,18 @@ def inspect_params(fn):
     import inspect
 
     return inspect.signature(fn).parameters
+
+
+def test_checked_kernels_compile_the_models_functions_with_numba(monkeypatch):
+    """NUMBA_BOUNDSCHECK=1 asks for kernels that check every index (to find a model's
+    stray write): a model's straight-line functions then go to numba as they are."""
+    import numba
+    from numba.core.dispatcher import Dispatcher
+
+    import stabdae
+    from stabdae.engine.rhs import _rejit
+
+    forces = stabdae.load_model("pendulum").functions["forces"]
+    assert not isinstance(_rejit(forces, None), Dispatcher)  # the emitter's intrinsic
+    monkeypatch.setattr(numba.config, "BOUNDSCHECK", 1)
+    assert isinstance(_rejit(forces, None), Dispatcher)

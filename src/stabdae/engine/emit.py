@@ -115,7 +115,7 @@ def _fold(node):
                 return node
             return ast.copy_location(ast.Constant(value), node)
 
-    return ast.fix_missing_locations(Fold().visit(node))
+    return Fold().visit(node)  # (never compiled by Python: no locations needed)
 
 
 class _Function:
@@ -132,13 +132,14 @@ class _Function:
             body = body[1:]  # a docstring
         self.ret = body.pop() if body and isinstance(body[-1], ast.Return) else None
         self.body = body
+        self.assigned = set()
         for node in ast.walk(self.fn_def):
             nested = node is not self.fn_def and isinstance(node, ast.FunctionDef)
             if nested or not isinstance(node, _SYNTAX):
                 raise _Refused(f"{type(node).__name__} in {fn_def.name}")
+            if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+                self.assigned.add(node.id)
         defined = set(self.params)
-        self.assigned = {n.id for n in ast.walk(self.fn_def) if isinstance(n, ast.Name)
-                         and isinstance(n.ctx, ast.Store)}  # fmt: skip
         for stmt in body:
             self._check_statement(stmt, defined)
         if self.ret is not None and self.ret.value is not None:
@@ -366,6 +367,15 @@ class _Lowering:
     def __init__(self, fn: _Function, typing: _Typing, context, builder, argtypes, args):
         self.fn, self.sigs, self.context, self.builder = fn, typing.sigs, context, builder
         self.names = {p: (t, v) for p, t, v in zip(fn.params, argtypes, args)}
+        # each array's data pointer, shape and strides read once, at the entry (which
+        # every use follows), for numba's own pointer arithmetic at each entry
+        self.arrays = {}
+        for p, t, v in zip(fn.params, argtypes, args):
+            if isinstance(t, types.Array):
+                array = context.make_array(t)(context, builder, v)
+                self.arrays[p] = (array, array.data,
+                                  cgutils.unpack_tuple(builder, array.shape, t.ndim),
+                                  cgutils.unpack_tuple(builder, array.strides, t.ndim))
 
     def cast(self, value, to):
         t, v = value
@@ -381,10 +391,11 @@ class _Lowering:
         return sig.return_type, impl(self.builder, vals)
 
     def pointer(self, array_node, index):
-        aryty, ary = self.names[array_node.id]
-        array = self.context.make_array(aryty)(self.context, self.builder, ary)
+        aryty = self.names[array_node.id][0]
+        _, data, shape, strides = self.arrays[array_node.id]
         idx = [self.context.get_constant(types.intp, i) for i in index]
-        return aryty, cgutils.get_item_pointer(self.context, self.builder, aryty, array, idx)
+        return aryty, cgutils.get_item_pointer2(self.context, self.builder, data, shape,
+                                                strides, aryty.layout, idx)  # fmt: skip
 
     def constant(self, value):
         t = _constant_type(self.context.typing_context, value)
@@ -429,11 +440,10 @@ class _Lowering:
 
     def store(self, target, value):
         index = target.slice.elts if isinstance(target.slice, ast.Tuple) else [target.slice]
-        aryty, ary = self.names[target.value.id]
+        aryty = self.names[target.value.id][0]
+        array, _, shape, _ = self.arrays[target.value.id]
         v = self.cast(value, aryty.dtype)
         if isinstance(index[0], ast.Slice):  # every entry
-            array = self.context.make_array(aryty)(self.context, self.builder, ary)
-            shape = cgutils.unpack_tuple(self.builder, array.shape, aryty.ndim)
             intp = self.context.get_value_type(types.intp)
             with cgutils.loop_nest(self.builder, shape, intp) as idx:
                 ptr = cgutils.get_item_pointer(self.context, self.builder, aryty, array, idx)

@@ -348,16 +348,16 @@ def _written_out(header: str, lines: list[str], label: str):
     (:func:`_scalarized`), compiled: lowered by :func:`.emit.emitted` (no numba typing of
     its statements) behind a one-line function that numba inlines where it is called
     (callable from Python), whose ``emitted`` attribute is the intrinsic itself."""
-    source = _scalarized(header + "\n" + "".join(f"    {line}\n" for line in lines or ["pass"]))
+    fn_def = _scalarized_tree(header + "\n" + "".join(f"    {line}\n"
+                                                      for line in lines or ["pass"]))
     name, params = header[4:header.index("(")], header[header.index("(") + 1:header.index(")")]
-    fn = exec_source(source, label, {"fma": fma, "fnma": _fnma, **_PY_ENTRY})[name]
     if not JIT:
-        return fn
+        return exec_source(_unparsed(fn_def), label, {"fma": fma, "fnma": _fnma, **_PY_ENTRY})[name]
     wrapper = f"def {name}({params}):\n    return _emitted({params})\n"
-    emitted_ = emitted(ast.parse(source).body[0], {}, label)
+    emitted_ = emitted(fn_def, {}, label)
     call = exec_source(wrapper, label + "_call", {"_emitted": emitted_})[name]
     out = njit(error_model="numpy", forceinline=True)(call)
-    out.straight_line = fn  # the Python function it does, for reading
+    out.straight_line = fn_def  # the code it does (:func:`_unparsed` reads it)
     out.emitted = emitted_  # for compiled callers: no function of its own to compile
     return out
 
@@ -390,6 +390,15 @@ def _entry(node) -> tuple | None:
 
 
 def _scalarized(source: str) -> str:
+    """:func:`_scalarized_tree`'s function as source."""
+    return _unparsed(_scalarized_tree(source))
+
+
+def _unparsed(fn_def: ast.FunctionDef) -> str:
+    return ast.unparse(ast.fix_missing_locations(fn_def)) + "\n"
+
+
+def _scalarized_tree(source: str) -> ast.FunctionDef:
     """The straight-line function ``source`` with each array entry it indexes by constants
     held in a local variable: read from its array once, before the first statement,
     where the code reads it before writing it, and written back once, before the
@@ -446,10 +455,11 @@ def _scalarized(source: str) -> str:
     ret = [i for i, stmt in enumerate(body) if isinstance(stmt, ast.Return)]
     if any(isinstance(n, ast.Return) for stmt in body for n in ast.walk(stmt)
            if not isinstance(stmt, ast.Return)) or ret[:-1]:  # fmt: skip
-        return source  # (only straight-line code with one return at its end is rewritten)
+        return ast.parse(source).body[0]  # (only straight-line code with one return at
+        # its end is rewritten)
     at = ret[0] if ret else len(body)
     fn.body = head + body[:at] + tail + body[at:] or [ast.Pass()]
-    return ast.unparse(ast.fix_missing_locations(fn)) + "\n"
+    return fn
 
 
 def _label(base: str, pattern) -> str:

@@ -36,6 +36,7 @@ import math
 from collections import namedtuple
 from typing import NamedTuple
 
+import numba
 import numpy as np
 from numba import njit
 
@@ -171,9 +172,11 @@ def _rejit(fn, absent):
     if fn is None:
         return absent
     pyfunc = python_function(fn)
-    if JIT:
+    if JIT and not numba.config.BOUNDSCHECK:
         # straight-line code (a generated model's) without numba's typing per statement,
-        # written into its callers (no function of its own for numba and LLVM to compile)
+        # written into its callers (no function of its own for numba and LLVM to compile);
+        # its indices are constants, which construction ran in range, but checked kernels
+        # asked for (NUMBA_BOUNDSCHECK=1) are numba's, every index checked
         try:
             return emitted_source(pyfunc, f"{pyfunc.__name__}_emitted")
         except NotImplementedError:
