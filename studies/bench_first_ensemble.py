@@ -91,8 +91,9 @@ def main(argv=None) -> None:
                              check=True, capture_output=True, text=True).stdout.strip()  # fmt: skip
         trees[f"at {rev}"] = work / "src"
     try:
-        for src in trees.values():  # the library's own functions into numba's cache
-            run(src, args.scenes[0], 64)
+        for src in trees.values():  # the library's own functions into numba's cache (each
+            for scene in args.scenes:  # scene's: the sines of one, the fits of another)
+                run(src, scene, 64)
         for scene in args.scenes:
             print(f"\n{scene}: first ensemble, {args.members} members (s)")
             best = {}
