@@ -81,6 +81,17 @@ def _signature(typingctx, fn, argtypes):
     return sig
 
 
+def _operation(node):
+    """``(numba's function, operand nodes)`` of an operator's node, else None."""
+    if isinstance(node, ast.BinOp):
+        return _BINARY[type(node.op)], (node.left, node.right)
+    if isinstance(node, ast.UnaryOp):
+        return _UNARY[type(node.op)], (node.operand,)
+    if isinstance(node, ast.Compare):
+        return _COMPARE[type(node.ops[0])], (node.left, node.comparators[0])
+    return None
+
+
 def _constant_type(typingctx, value):
     """A constant's type as numba's type inference gives it: Literal[int](2), float64."""
     return types.maybe_literal(value) or typingctx.resolve_value_type(value)
@@ -285,7 +296,42 @@ class _Function:
             defined.add(t.id)
 
 
-class _Typing:
+class _Walk:
+    """What typing and lowering share: the statements, in order, with the names they bind
+    (``expr``, ``apply`` an operation to values, ``set_entry`` and ``assign_entry`` are
+    each's own)."""
+
+    def statement(self, stmt):
+        if isinstance(stmt, ast.Pass):
+            return
+        if isinstance(stmt, ast.Expr):  # _set1, _set2
+            self.set_entry(stmt.value)
+            return
+        if isinstance(stmt, ast.AugAssign):
+            name = stmt.target.id
+            self.names[name] = self.apply(stmt, _INPLACE[type(stmt.op)],
+                                          (self.names[name], self.expr(stmt.value)))
+            return
+        target, value = stmt.targets[0], stmt.value
+        if isinstance(target, ast.Tuple):
+            values = [self.expr(v) for v in value.elts]
+            for t, v in zip(target.elts, values):
+                self.names[t.id] = v
+        elif isinstance(target, ast.Subscript):
+            self.assign_entry(target, value)
+        else:
+            self.names[target.id] = self.expr(value)
+
+    def operation(self, node):
+        """The value of an operator's node (None: not an operator)."""
+        operation = _operation(node)
+        if operation is None:
+            return None
+        op, operands = operation
+        return self.apply(node, op, [self.expr(a) for a in operands])
+
+
+class _Typing(_Walk):
     """The numba types of a :class:`_Function`'s values for given argument types, and the
     signatures of its operations (by node), as numba's type inference would find them."""
 
@@ -316,14 +362,9 @@ class _Typing:
             return _constant_type(self.tc, value)
         if isinstance(node, ast.Subscript):
             return self.names[node.value.id].dtype
-        if isinstance(node, ast.BinOp):
-            left, right = self.expr(node.left), self.expr(node.right)
-            return self.op(node, _BINARY[type(node.op)], (left, right))
-        if isinstance(node, ast.UnaryOp):
-            return self.op(node, _UNARY[type(node.op)], (self.expr(node.operand),))
-        if isinstance(node, ast.Compare):
-            return self.op(node, _COMPARE[type(node.ops[0])],
-                           (self.expr(node.left), self.expr(node.comparators[0])))  # fmt: skip
+        value = self.operation(node)
+        if value is not None:
+            return value
         if isinstance(node, ast.Call):
             callee = fn.callee(node)
             if callee in ("_at1", "_at2"):
@@ -338,29 +379,17 @@ class _Typing:
             return self.op(node, callee, args)
         raise _Refused(ast.unparse(node))
 
-    def statement(self, stmt):
-        if isinstance(stmt, ast.Expr):  # _set1, _set2
-            self.expr(stmt.value.args[-1])
-            return
-        if isinstance(stmt, ast.AugAssign):
-            name = stmt.target.id
-            self.names[name] = self.op(stmt, _INPLACE[type(stmt.op)],
-                                       (self.names[name], self.expr(stmt.value)))  # fmt: skip
-            return
-        if isinstance(stmt, ast.Pass):
-            return
-        target, value = stmt.targets[0], stmt.value
-        if isinstance(target, ast.Tuple):
-            values = [self.expr(v) for v in value.elts]
-            for t, v in zip(target.elts, values):
-                self.names[t.id] = v
-        elif isinstance(target, ast.Subscript):
-            self.expr(value)
-        else:
-            self.names[target.id] = self.expr(value)
+    def apply(self, node, fn, values):
+        return self.op(node, fn, values)
+
+    def set_entry(self, call):
+        self.expr(call.args[-1])
+
+    def assign_entry(self, target, value):
+        self.expr(value)
 
 
-class _Lowering:
+class _Lowering(_Walk):
     """A :class:`_Function` written into ``builder`` with its :class:`_Typing`: every
     value a pair ``(numba type, llvm value)``."""
 
@@ -412,14 +441,9 @@ class _Lowering:
             index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
             aryty, ptr = self.pointer(node.value, [i.value for i in index])
             return aryty.dtype, b.load(ptr)
-        if isinstance(node, ast.BinOp):
-            left, right = self.expr(node.left), self.expr(node.right)
-            return self.call_impl(node, _BINARY[type(node.op)], (left, right))
-        if isinstance(node, ast.UnaryOp):
-            return self.call_impl(node, _UNARY[type(node.op)], (self.expr(node.operand),))
-        if isinstance(node, ast.Compare):
-            return self.call_impl(node, _COMPARE[type(node.ops[0])],
-                                  (self.expr(node.left), self.expr(node.comparators[0])))
+        value = self.operation(node)
+        if value is not None:
+            return value
         callee = fn.callee(node)
         if callee in ("_at1", "_at2"):
             aryty, ptr = self.pointer(node.args[0], [i.value for i in node.args[1:]])
@@ -452,28 +476,15 @@ class _Lowering:
         _, ptr = self.pointer(target.value, [i.value for i in index])
         self.builder.store(v, ptr)
 
-    def statement(self, stmt):
-        if isinstance(stmt, ast.Pass):
-            return
-        if isinstance(stmt, ast.Expr):  # _set1, _set2
-            call = stmt.value
-            aryty, ptr = self.pointer(call.args[0], [i.value for i in call.args[1:-1]])
-            self.builder.store(self.cast(self.expr(call.args[-1]), aryty.dtype), ptr)
-            return
-        if isinstance(stmt, ast.AugAssign):
-            name = stmt.target.id
-            self.names[name] = self.call_impl(stmt, _INPLACE[type(stmt.op)],
-                                              (self.names[name], self.expr(stmt.value)))
-            return
-        target, value = stmt.targets[0], stmt.value
-        if isinstance(target, ast.Tuple):
-            values = [self.expr(v) for v in value.elts]
-            for t, v in zip(target.elts, values):
-                self.names[t.id] = v
-        elif isinstance(target, ast.Subscript):
-            self.store(target, self.expr(value))
-        else:
-            self.names[target.id] = self.expr(value)
+    def apply(self, node, fn, values):
+        return self.call_impl(node, fn, values)
+
+    def set_entry(self, call):
+        aryty, ptr = self.pointer(call.args[0], [i.value for i in call.args[1:-1]])
+        self.builder.store(self.cast(self.expr(call.args[-1]), aryty.dtype), ptr)
+
+    def assign_entry(self, target, value):
+        self.store(target, self.expr(value))
 
 
 def emitted(fn_def: ast.FunctionDef, namespace: dict, label: str, fused: bool = HOST_FMA):
