@@ -132,6 +132,17 @@ def test_code_outside_the_language_is_refused_when_emitted(body):
         emitted(fn_def, {"np": np, "g": len}, "emit_test_refused")
 
 
+def test_an_entry_of_a_matrix_needs_every_index():
+    """``out[0]`` of a matrix is a row, not a number: refused when typed, with a message
+    that names the array and says what to do."""
+    fn_def = ast.parse("def f(a, out):\n    out[0] = a[1]\n").body[0]
+    intr = emitted(fn_def, {}, "emit_test_row")
+    ns = {"_emitted": intr}
+    exec("def g(a, out):\n    return _emitted(a, out)\n", ns)
+    with pytest.raises(Exception, match=r"out\[0\] of a 2-d array in f: give every index"):
+        njit(ns["g"])(np.ones(3), np.zeros((2, 2)))
+
+
 def test_a_function_with_free_variables_or_no_source_is_refused():
     """A model's function is compiled by numba as it is where its source cannot be read
     or it reads variables of an enclosing function (which numba freezes)."""

@@ -92,6 +92,11 @@ def _operation(node):
     return None
 
 
+def _index(node) -> list:
+    """A subscript's indices."""
+    return node.elts if isinstance(node, ast.Tuple) else [node]
+
+
 def _constant_type(typingctx, value):
     """A constant's type as numba's type inference gives it: Literal[int](2), float64."""
     return types.maybe_literal(value) or typingctx.resolve_value_type(value)
@@ -247,7 +252,7 @@ class _Function:
 
     def _entry(self, node, defined, store):
         self._array(node.value, defined)
-        index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+        index = _index(node.slice)
         if store and all(isinstance(i, ast.Slice) and i.lower is None and i.upper is None
                          and i.step is None for i in index):  # fmt: skip
             return "fill"
@@ -361,7 +366,7 @@ class _Typing(_Walk):
         if value is not None:
             return _constant_type(self.tc, value)
         if isinstance(node, ast.Subscript):
-            return self.names[node.value.id].dtype
+            return self.entry(node.value.id, node.slice)
         value = self.operation(node)
         if value is not None:
             return value
@@ -386,7 +391,17 @@ class _Typing(_Walk):
         self.expr(call.args[-1])
 
     def assign_entry(self, target, value):
+        if not isinstance(_index(target.slice)[0], ast.Slice):
+            self.entry(target.value.id, target.slice)
         self.expr(value)
+
+    def entry(self, name, index):
+        """The type of ``name[index]``: one of its entries, all its indices given."""
+        aryty = self.names[name]
+        if len(_index(index)) != aryty.ndim:
+            raise _Refused(f"{name}[{ast.unparse(index)}] of a {aryty.ndim}-d array in "
+                           f"{self.fn.fn_def.name}: give every index")  # fmt: skip
+        return aryty.dtype
 
 
 class _Lowering(_Walk):
@@ -438,7 +453,7 @@ class _Lowering(_Walk):
         if value is not None:
             return self.constant(value)
         if isinstance(node, ast.Subscript):
-            index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+            index = _index(node.slice)
             aryty, ptr = self.pointer(node.value, [i.value for i in index])
             return aryty.dtype, b.load(ptr)
         value = self.operation(node)
@@ -463,7 +478,7 @@ class _Lowering(_Walk):
         return self.call_impl(node, callee, args)
 
     def store(self, target, value):
-        index = target.slice.elts if isinstance(target.slice, ast.Tuple) else [target.slice]
+        index = _index(target.slice)
         aryty = self.names[target.value.id][0]
         array, _, shape, _ = self.arrays[target.value.id]
         v = self.cast(value, aryty.dtype)

@@ -57,20 +57,6 @@ def _fused(typingctx, a, b, c):
     return types.float64(a, b, c), codegen
 
 
-@intrinsic
-def _fused_negated(typingctx, a, b, c):
-    """``fma(-a, b, c)`` as one intrinsic (the negation is exact: the same bits), for
-    generated code, where the negation would be one more statement for numba to type."""
-    if not all(isinstance(x, (types.Float, types.Integer)) for x in (a, b, c)):
-        return None
-
-    def codegen(context, builder, sig, args):
-        a, b, c = (context.cast(builder, v, t, types.float64) for v, t in zip(args, sig.args))
-        return builder.fma(builder.fneg(a), b, c)
-
-    return types.float64(a, b, c), codegen
-
-
 @njit(cache=True, forceinline=True, error_model="numpy")
 def _fused_fma(a, b, c):
     return _fused(a, b, c)
