@@ -55,27 +55,20 @@ clock = time.perf_counter()
 factor, solve = linalg.ldl_factor_for(n).emitted, linalg.ldl_solve_for(n).emitted
 written = time.perf_counter() - clock
 
-@njit(error_model="numpy")
-def out(A, b, reps):
-    s = 0.0
-    for _ in range(reps):
-        for i in range(A.shape[0]):
-            a, x = A[i].copy(), b[i].copy()
-            factor(a, n, 1e-14)
-            solve(a, n, x)
-            s += x[0]
-    return s
+def timed(factor, solve):
+    @njit(error_model="numpy")
+    def run(A, b, reps):
+        s = 0.0
+        for _ in range(reps):
+            for i in range(A.shape[0]):
+                a, x = A[i].copy(), b[i].copy()
+                factor(a, n, 1e-14)
+                solve(a, n, x)
+                s += x[0]
+        return s
+    return run
 
-@njit(error_model="numpy")
-def loops(A, b, reps):
-    s = 0.0
-    for _ in range(reps):
-        for i in range(A.shape[0]):
-            a, x = A[i].copy(), b[i].copy()
-            linalg.ldl_inplace(a, n, 1e-14)
-            linalg.ldl_solve_inplace(a, n, x)
-            s += x[0]
-    return s
+out, loops = timed(factor, solve), timed(linalg.ldl_inplace, linalg.ldl_solve_inplace)
 
 rng = np.random.default_rng(0)
 B = rng.standard_normal((64, n, n))

@@ -4,8 +4,8 @@ A generated model's functions and the written-out linear algebra (:mod:`.linalg`
 :mod:`.rhs`) are thousands of statements such as ``e12 = e3 * psi_dot`` or
 ``s = fma(a, b, s)`` on array entries indexed by constants.  numba compiles such a
 function statement by statement: it types every operator and call by trying its overloads
-in turn, then looks them up again to lower them, one to a few milliseconds a statement,
-which made most of a coupled mechanism's first ensemble.  The types in such code follow
+in turn, then looks them up again to lower them, which made most of a coupled
+mechanism's first ensemble.  The types in such code follow
 from the arguments' alone, so :func:`emitted` types it in one pass of its own, asking
 numba's typing only once for each distinct operation and argument types (``float64 *
 float64``), and lowers it with numba's own implementations of those operations, called as

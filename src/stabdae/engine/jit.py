@@ -38,8 +38,8 @@ def python_function(fn):
 def internal(**options):
     """``njit(**options)`` for a function that compiled code calls (a kernel's pieces):
     numba then builds neither its CPython nor its C wrapper, code that boxes and unboxes
-    every argument (a workspace is a tuple of arrays) and goes through LLVM with the rest,
-    about a second of a model's first ensemble over the pieces.  A call from Python goes
+    every argument (a workspace is a tuple of arrays) and goes through LLVM with the rest
+    of a model's first ensemble.  A call from Python goes
     to its twin with the wrappers, compiled when first called (:func:`from_python`)."""
     decorate = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True, **options)
 

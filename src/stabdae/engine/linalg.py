@@ -19,7 +19,8 @@ out for its sizes (:func:`ldl_factor_for`, :func:`ldl_solve_for`,
 :func:`ldl_solve_columns_for`): straight-line code with the same operations in the same
 order, so the same numbers bit for bit.  LLVM vectorizes innermost loops only; a factor's
 loop over its columns, which it does not unroll when the body is large, left the ensemble
-kernel's member loop around it scalar.
+kernel's member loop around it scalar.  The written-out code is compiled by
+:mod:`.emit`, not statement by statement by numba.
 
 Given a matrix's structural zeros (a model's patterns, :mod:`.sparsity`), the written-out
 factor and solves leave out the terms that are structurally zero in the factor (its fill
@@ -37,17 +38,16 @@ from functools import cache
 import numpy as np
 from numba import njit
 
-from .emit import emitted
+from .emit import _index, emitted
 from .fma import fma
 from .jit import JIT
 from .source import exec_source
 from .sparsity import fill_pattern
 
 #: the routines are written out when they take at most this many multiply-adds; larger ones
-#: keep their loops, whose code does not grow with the size.  Written out (and compiled by
-#: :mod:`.emit`), a 12-coordinate bicycle's ``M⁻¹ Fᵀ`` of 1230 multiply-adds compiled
-#: faster than the loops around it and integrated 4× as fast; a dense factor and solve
-#: compile in about 1.5 ms a multiply-add (n = 30: 6.5 s), which this bounds
+#: keep their loops, whose code does not grow with the size.  Written out, they integrate
+#: several times as fast; the compile time grows with the multiply-adds, which this bounds
+#: (the trade, measured: studies/README.md, ``bench_written_out.py``)
 UNROLL_MAX_OPS = 2048
 
 
@@ -383,7 +383,7 @@ def _entry(node) -> tuple | None:
     """``(array, (i, j, ...))`` of a subscript by integer constants, else None."""
     if not (isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name)):
         return None
-    index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+    index = _index(node.slice)
     if not all(isinstance(i, ast.Constant) and type(i.value) is int for i in index):
         return None
     return node.value.id, tuple(i.value for i in index)
@@ -404,10 +404,10 @@ def _scalarized_tree(source: str) -> ast.FunctionDef:
     where the code reads it before writing it, and written back once, before the
     ``return`` (or at the end), where the code writes it.  The same operations on the same
     values in the same order, so the same bits (the arguments are distinct buffers: no
-    entry is reached through two names).  numba types every subscript by trying each of
-    its overloads of ``getitem`` and ``setitem`` in turn, about as long as all the
-    arithmetic around it: a factor written out for a size of 10 read its entries a
-    thousand times, now a hundred."""
+    entry is reached through two names).  The operations read each entry many times (a
+    cubic number in a factor); LLVM, which cannot tell that the arrays do not overlap,
+    would load it again after every store to another array, and each access is code to
+    generate and optimize."""
     fn = ast.parse(source).body[0]
     dynamic = {n.value.id for n in ast.walk(fn) if isinstance(n, ast.Subscript)
                and isinstance(n.value, ast.Name) and _entry(n) is None}  # fmt: skip
