@@ -405,9 +405,9 @@ def _scalarized_tree(source: str) -> ast.FunctionDef:
     ``return`` (or at the end), where the code writes it.  The same operations on the same
     values in the same order, so the same bits (the arguments are distinct buffers: no
     entry is reached through two names).  The operations read each entry many times (a
-    cubic number in a factor); LLVM, which cannot tell that the arrays do not overlap,
-    would load it again after every store to another array, and each access is code to
-    generate and optimize."""
+    cubic number in a factor); held in a local, it is loaded once, where LLVM, told
+    nothing of whether the arrays overlap, may load it again after a store to another
+    array, and each access is code to generate and optimize."""
     fn = ast.parse(source).body[0]
     dynamic = {n.value.id for n in ast.walk(fn) if isinstance(n, ast.Subscript)
                and isinstance(n.value, ast.Name) and _entry(n) is None}  # fmt: skip
