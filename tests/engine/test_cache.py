@@ -542,3 +542,50 @@ def test_an_internal_function_has_no_wrappers_and_python_calls_reach_its_twin():
     assert twin is from_python(piece) and twin is not piece
     assert "cpython" in twin.overloads[twin.signatures[0]].library.get_llvm_str()
     assert from_python(caller) is caller  # anything else: itself
+
+
+@pytest.mark.skipif(not stabdae.engine.jit.JIT, reason="numba's code libraries: needs the JIT")
+def test_an_internal_function_is_compiled_for_its_callers_only(capfd):
+    """An uncached piece gets no machine code of its own: its callers link its LLVM IR and
+    compile it with theirs, so the engine holds no symbol of it, and the callers compute
+    what the piece computes.  A piece whose code reads its environment (``print`` does)
+    gets its machine code, and its environment, as before, and runs.  A piece cached on
+    disk keeps numba's compilation (the cache stores machine code)."""
+    from stabdae.engine.jit import _LINK_ONLY, internal
+
+    if not _LINK_ONLY:
+        pytest.skip("this numba has no hook to compile to LLVM IR only")
+
+    @internal(error_model="numpy")
+    def quiet(x, out):
+        out[0] = 3.0 * x
+        return out[0] - 1.0
+
+    @internal()
+    def loud(x):
+        print("loud", x)
+        return x + 0.5
+
+    @njit
+    def caller(x):
+        out = np.zeros(1)
+        return quiet(x, out) + loud(x) + out[0]
+
+    assert caller(2.0) == 5.0 + 2.5 + 6.0
+    assert "loud 2.0" in capfd.readouterr().out
+
+    def address(piece):
+        (sig,) = piece.signatures
+        cres = piece.overloads[sig]
+        return cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
+
+    assert address(quiet) == 0
+    assert address(loud) != 0
+    out = np.zeros(1)
+    assert quiet(2.0, out) == 5.0 and out[0] == 6.0  # from Python: the twin, as before
+
+    @internal(cache=True)
+    def cached(x):
+        return x
+
+    assert type(cached._compiler) is not type(quiet._compiler)

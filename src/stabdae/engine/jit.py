@@ -13,15 +13,23 @@ import inspect
 import threading
 import time
 
-from numba import config, njit
+from numba import _dynfunc, config, njit
 from numba.core import event
-from numba.core.dispatcher import Dispatcher
+from numba.core.codegen import JITCodeLibrary
+from numba.core.compiler import Flags
+from numba.core.dispatcher import Dispatcher, _FunctionCompiler
 from numba.core.registry import CPUDispatcher
 
 __all__ = ["JIT", "compile_seconds", "from_python", "internal", "is_njit", "python_function"]
 
 #: False when numba's JIT is switched off (``NUMBA_DISABLE_JIT=1``)
 JIT = not config.DISABLE_JIT
+
+
+#: numba's hooks for compiling a function to LLVM IR only (internal API: without them,
+#: :func:`internal` functions get machine code of their own, as any other)
+_LINK_ONLY = (hasattr(_FunctionCompiler, "_customize_flags")
+              and "no_compile" in getattr(Flags, "options", {"no_compile": None}))
 
 
 def is_njit(fn) -> bool:
@@ -39,14 +47,19 @@ def internal(**options):
     """``njit(**options)`` for a function that compiled code calls (a kernel's pieces):
     numba then builds neither its CPython nor its C wrapper, code that boxes and unboxes
     every argument (a workspace is a tuple of arrays) and goes through LLVM with the rest
-    of a model's first ensemble.  A call from Python goes
-    to its twin with the wrappers, compiled when first called (:func:`from_python`)."""
+    of a model's first ensemble.  Unless it is cached on disk (``cache=True``), its
+    compilation also stops at the optimized LLVM IR that its callers link in and compile
+    with their own code: no machine code of its own, which nothing would run (callers
+    never call into another library's machine code).  A call from Python goes to its
+    twin with the wrappers, compiled when first called (:func:`from_python`)."""
     decorate = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True, **options)
 
     def make(fn):
         dispatcher = decorate(fn)
         if JIT:
             dispatcher.__class__ = _Internal
+            if _LINK_ONLY and not options.get("cache"):
+                dispatcher._compiler.__class__ = _LinkOnlyCompiler
         return dispatcher
 
     return make
@@ -71,6 +84,51 @@ class _Internal(CPUDispatcher):
 
     def __call__(self, *args, **kwargs):
         return from_python(self)(*args, **kwargs)
+
+    def add_overload(self, cres):
+        if cres.entry_point is None and not cres.objectmode:  # compiled for linking only
+            # what numba's lowering registers for a compiled function, without asking
+            # the library for an address (the call target is the function in the IR its
+            # callers link in; the Python-facing address of a function without wrappers
+            # is null either way)
+            library, fndesc, env = cres.library, cres.fndesc, cres.environment
+            library.__class__ = _LinkOnlyLibrary
+            library.env_global = (self.targetctx.get_env_name(fndesc), env)
+            entry = _dynfunc.make_function(fndesc.lookup_module(),
+                                           fndesc.qualname.split(".")[-1],
+                                           f"compiled for linking only: {fndesc.qualname!r}",
+                                           0, env, (library,))  # fmt: skip
+            self.targetctx.insert_user_function(entry, fndesc, [library])
+            cres = cres._replace(entry_point=entry)
+        super().add_overload(cres)
+
+
+class _LinkOnlyCompiler(_FunctionCompiler):
+    """Compiles to LLVM IR and stops there (numba's ``no_compile``)."""
+
+    def _customize_flags(self, flags):
+        flags = super()._customize_flags(flags)
+        flags.no_compile = True
+        return flags
+
+
+class _LinkOnlyLibrary(JITCodeLibrary):
+    """The code library of a function compiled for linking only: finalized (its IR
+    optimized, as callers link it) without the machine code of its own, unless its code
+    reads its environment, which only an engine that holds the code can point to."""
+
+    env_global: tuple = ("", None)
+
+    def _finalize_final_module(self):
+        name, env = self.env_global
+        # the module defines the global once; any other mention is a use
+        if str(self._final_module).count(name) > 1:
+            super()._finalize_final_module()
+            self.codegen.set_env(name, env)
+            return
+        self._finalize_dynamic_globals()
+        self._verify_declare_only_symbols()
+        self._finalized = True
 
 
 class _CompileClock(event.Listener):
