@@ -81,6 +81,21 @@ def _signature(typingctx, fn, argtypes):
     return sig
 
 
+#: numba's implementation for each target context, operation and signature met so far
+#: (numba looks one up at every call, a tenth of a millisecond: most of the lowering of
+#: a generated model's thousands of operations)
+_IMPLEMENTATIONS: dict = {}
+
+
+def _implementation(context, fn, sig):
+    key = (context, fn, sig)
+    impl = _IMPLEMENTATIONS.get(key)
+    if impl is None:
+        fnty = context.typing_context.resolve_value_type(fn)
+        impl = _IMPLEMENTATIONS[key] = context.get_function(fnty, sig)
+    return impl
+
+
 def _operation(node):
     """``(numba's function, operand nodes)`` of an operator's node, else None."""
     if isinstance(node, ast.BinOp):
@@ -429,8 +444,7 @@ class _Lowering(_Walk):
         """numba's implementation of ``fn`` at ``node``'s signature, the operands cast to
         its argument types."""
         sig = self.sigs[id(node)]
-        fnty = self.context.typing_context.resolve_value_type(fn)
-        impl = self.context.get_function(fnty, sig)
+        impl = _implementation(self.context, fn, sig)
         vals = [self.cast(a, t) for a, t in zip(args, sig.args)]
         return sig.return_type, impl(self.builder, vals)
 

@@ -70,6 +70,14 @@ def build_sampler(K, spec: Spec):
     eps = np.finfo(np.float64).eps
 
     @internal(error_model="numpy")
+    def g_at(t0, x, p, ws, g):
+        """``g(x, t0)`` into ``g``: the residual in a function of its own, which LLVM
+        compiles once for the sampler's three calls (inlined at each, as it is into the
+        ensemble kernel's steps, it went through LLVM three times; a call costs nothing
+        beside the Newton steps)."""
+        residual(t0, x, p, ws, g)
+
+    @internal(error_model="numpy")
     def jacobian(x, t0, p, ws, xp, gpm, G, GGt):
         """``G = ∂g/∂x`` at ``x`` by central differences and the L D Lᵀ factor of
         ``G Gᵀ`` into ``GGt``; whether the factorization failed."""
@@ -78,9 +86,9 @@ def build_sampler(K, spec: Spec):
             for k in range(N2):
                 xp[k] = x[k]
             xp[l] = x[l] + h
-            residual(t0, xp, p, ws, gpm[0])
+            g_at(t0, xp, p, ws, gpm[0])
             xp[l] = x[l] - h
-            residual(t0, xp, p, ws, gpm[1])
+            g_at(t0, xp, p, ws, gpm[1])
             for i in range(ng):
                 G[i, l] = (gpm[0, i] - gpm[1, i]) / (2.0 * h)
         for i in range(ng):
@@ -101,9 +109,8 @@ def build_sampler(K, spec: Spec):
         (the same for every member: the first step is the minimum-norm one) while each
         at least quarters the error, then the Jacobian at the current state (Gauss–Newton
         proper) at every step.
-        (The residual is called from one place here and two in :func:`jacobian`: each
-        call is compiled inline, and more were a tenth of a new model's sampler
-        compilation.)"""
+        (The residual is called from one place here and two in :func:`jacobian`, each a
+        call of :func:`g_at`.)"""
         for l in range(N2):
             x[l] = x_start[l]
         amax = 0.0
@@ -116,7 +123,7 @@ def build_sampler(K, spec: Spec):
         xnorm = 0.0
         it = 0
         while True:
-            residual(t0, x, p, ws, gp)
+            g_at(t0, x, p, ws, gp)
             if not newton:
                 return 0
             err = 0.0
@@ -192,7 +199,7 @@ def build_sampler(K, spec: Spec):
                     alpha_out[j, i] = gp[i]
 
     key = spec.key(K.key)
-    tag(key, place, jacobian)
+    tag(key, place, jacobian, g_at)
     return keyed_cache(sample_kernel, key)
 
 
