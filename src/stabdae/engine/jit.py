@@ -29,7 +29,7 @@ JIT = not config.DISABLE_JIT
 #: numba's hooks for compiling a function to LLVM IR only (internal API: without them,
 #: :func:`internal` functions get machine code of their own, as any other)
 _LINK_ONLY = (hasattr(_FunctionCompiler, "_customize_flags")
-              and "no_compile" in getattr(Flags, "options", {"no_compile": None}))
+              and "no_compile" in getattr(Flags, "options", {}))
 
 
 def is_njit(fn) -> bool:
