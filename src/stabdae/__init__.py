@@ -20,6 +20,7 @@ from ._laws import Law, LawError, acpr, baumgarte, matrix, none, theorem5, user
 from ._loading import load_model, scene_names
 from ._model import Model, ModelError
 from ._profile import paired_difference, radial_profile
+from ._schema import open_dataset, write_netcdf
 from ._schemes import (
     Scheme,
     SchemeError,
@@ -64,6 +65,7 @@ __all__ = [
     "matrix",
     "midpoint",
     "none",
+    "open_dataset",
     "paired_difference",
     "radial_profile",
     "rk3",
@@ -74,4 +76,5 @@ __all__ = [
     "theory",
     "two_stage",
     "user",
+    "write_netcdf",
 ]

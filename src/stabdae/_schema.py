@@ -4,12 +4,15 @@ NetCDF writing.
 :data:`SCHEMA` names every variable of every dataset (a trajectory, an ensemble, the
 theory of a study's grid, the theory along a path, a study) with its dimensions, long name
 and units, and :func:`schema_variable` builds it.  Units are UDUNITS strings
-(:func:`udunits_ok`).  A variable whose components have different units (the state
-``x = (q, v)``, the residual ``g = (f, ḟ, h)``) has no single ``units`` attribute: its
-``units_per_component`` attribute names the coordinate that holds each component's unit
-(``state_units``, ``component_units``), taken from the model's declaration
-(:class:`stabdae.Model`'s ``coordinate_units`` and ``constraint_units``).  The norm of the
-residual has the constraints' unit when they share one.
+(:func:`udunits_ok`).  A variable whose entries have different units (the state
+``x = (q, v)``, the residual ``g = (f, ḟ, h)``) has no single ``units`` attribute in
+memory: its ``units_per_component`` attribute names the coordinate that holds each entry's
+unit (``state_units``, ``component_units``), taken from the model's declaration
+(:class:`stabdae.Model`'s ``coordinate_units`` and ``constraint_units``).  On disk
+(:func:`write_netcdf`) such a variable is one variable per entry, each with its unit, as
+CF has it; :func:`open_dataset` stacks them again.  A norm of the residual has the
+constraints' unit when its components share one, and is otherwise the norm of ``g`` with
+each component divided by its unit: unit ``1``.
 
 :func:`provenance` stamps what produced a dataset; :func:`append_history` adds a line to
 its ``history`` for every later action, with times in one format (:func:`utc_now`).
@@ -48,9 +51,9 @@ from ._vector_width import PREFER_512
 from ._version import __version__
 from .engine.fma import HOST_FMA
 
-__all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "provenance",
-           "schema_markdown", "schema_variable", "trajectory_dataset", "udunits_ok", "utc_now",
-           "variable", "write_netcdf"]  # fmt: skip
+__all__ = ["SCHEMA", "append_history", "component_coords", "model_coords", "open_dataset",
+           "provenance", "schema_markdown", "schema_variable", "split_entries",
+           "trajectory_dataset", "udunits_ok", "utc_now", "variable", "write_netcdf"]  # fmt: skip
 
 #: units markers resolved per model: the state's, the residual components', the residual
 #: norm's (the constraints' common unit), the energy's
@@ -294,7 +297,8 @@ _GROUPS = (
 _MARKER_TEXT = {
     STATE: "per state entry (`state_units`)",
     COMPONENT: "per residual component (`component_units`)",
-    RESIDUAL: "the constraints' unit (per component where they differ)",
+    RESIDUAL: "the constraints' unit (`1` where they differ: each component divided by "
+              "its unit)",
     ENERGY: "the model's `energy_units`",
     MULTIPLIER: "per constraint (`multiplier_units`: energy per constraint unit)",
     ACCELERATION: "per coordinate (`acceleration_units`)",
@@ -308,11 +312,17 @@ def schema_markdown() -> str:
         "# Dataset schema",
         "",
         "Generated from `stabdae._schema.SCHEMA` (a test checks that this page matches it).",
-        "Units are UDUNITS strings.  A variable whose entries have different units (the",
-        "state `x = (q, v)`, the residual `g = (f, ḟ, h)`) has no `units` attribute but",
-        "`units_per_component`, naming the coordinate (`state_units`, `component_units`)",
-        "that holds each entry's unit, from the model's `coordinate_units` and",
-        "`constraint_units`.  Every dataset has `created_at` (`YYYY-MM-DDThh:mm:ssZ`, UTC)",
+        "Units are UDUNITS strings.  In memory, a variable whose entries have different",
+        "units (the state `x = (q, v)`, the residual `g = (f, ḟ, h)`) has no `units`",
+        "attribute but `units_per_component`, naming the coordinate (`state_units`,",
+        "`component_units`) that holds each entry's unit, from the model's",
+        "`coordinate_units` and `constraint_units`.  In a file written by",
+        "`stabdae.write_netcdf` it is one variable per entry (`x__theta`, each with its",
+        "`units` and `stacked_from = \"x\"`), as CF has it; `stabdae.open_dataset` stacks",
+        "them again.  A norm over residual components of different units (the pendulum's",
+        "f in m² and ḟ in m² s-1) is the norm of g with each component divided by its unit,",
+        "a pure number: unit `1`, and a `comment` that says so.",
+        "Every dataset has `created_at` (`YYYY-MM-DDThh:mm:ssZ`, UTC)",
         "and a `history` with one line per action (`<time>: <action> (stabdae <version>)`).",
         "An ensemble stores " + ", ".join(f"`{n}`" for n in SINGLE_PRECISION) + " in single",
         "precision (seven digits: more than any of them is measured to) and its counts",
@@ -400,11 +410,18 @@ def _resolve_units(marker: str, model) -> dict:
     common = _common(getattr(model, coord)) if model is not None else None
     if common:
         return {"units": common}
-    out = {"units_per_component": coord}
     if marker == RESIDUAL:
-        out["comment_units"] = ("max over residual components of different units: in the "
-                                "unit of the largest component")  # fmt: skip
-    return out
+        # a norm over components of different units is the norm of the vector whose
+        # entries are g_i / [g_i], each component divided by its declared unit: a pure
+        # number (what every stored norm's value is), the way a solver's error norm
+        # divides each component by its tolerance
+        return {"units": "1", "comment_units": MIXED_NORM}
+    return {"units_per_component": coord}
+
+
+#: what a norm over residual components of different units is (its ``comment``)
+MIXED_NORM = ("a norm over components of different units (component_units): of g with "
+              "each component divided by its unit, a pure number")
 
 
 def variable(dims, data, long_name: str, units: str | None, **attrs) -> xr.Variable:
@@ -601,8 +618,13 @@ def trajectory_dataset(model, p, law, scheme, times, xs, gs, es, status, done, r
 
 
 def write_netcdf(ds: xr.Dataset, path, *, compress: int = 1, overwrite: bool = True) -> Path:
-    """Write ``ds`` to ``path`` atomically: a temporary file in the same folder, then rename.
+    """Write a stabdae dataset to ``path`` as a CF file, atomically: a temporary file in the
+    same folder, then rename.
 
+    Every variable on disk has one unit: a variable whose entries have different units
+    (``x``, ``residual``, ``alpha0``, … with ``units_per_component``) is written as one
+    variable per entry, ``x__theta`` for entry ``theta`` of ``x``, which
+    :func:`open_dataset` stacks again (``xarray.open_dataset`` shows them as they are).
     A reader never sees a half-written file, and a failure leaves any previous file intact.
     Floating-point and integer variables are zlib-compressed at level ``compress`` (with
     the shuffle filter; on the residual traces that make most of a study, level 1 comes
@@ -666,6 +688,79 @@ def _cf_encoded(ds: xr.Dataset) -> xr.Dataset:
     return ds
 
 
+#: the attributes that tie a variable on disk to the variable with per-entry units it is
+#: one entry of (:func:`split_entries`, :func:`open_dataset`)
+STACKED = ("stacked_from", "stacked_along", "stacked_axis", "stacked_units")
+
+
+def split_entries(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` with one variable per entry in place of each variable whose entries have
+    different units (``units_per_component``): CF gives a variable one unit, and a variable
+    without one is read as a pure number.  Entry ``label`` of ``x`` along ``state`` becomes
+    ``x__label``, with its own ``units`` and the attributes of :data:`STACKED` by which
+    :func:`open_dataset` stacks the entries again."""
+    split = [name for name, var in ds.data_vars.items() if "units_per_component" in var.attrs]
+    if not split:
+        return ds
+    out = {}
+    for name in split:
+        var = ds[name]
+        units_coord = var.attrs["units_per_component"]
+        dim = ds[units_coord].dims[0]
+        attrs = {k: v for k, v in var.attrs.items() if k != "units_per_component"}
+        for i, (label, unit) in enumerate(zip(ds[dim].values, ds[units_coord].values)):
+            entry = var.variable.isel({dim: i})
+            entry.attrs = {**attrs, "long_name": f"{attrs.get('long_name', name)}: {label}",
+                           "units": str(unit), "stacked_from": name, "stacked_along": dim,
+                           "stacked_axis": var.dims.index(dim), "stacked_units": units_coord}
+            entry.encoding = dict(var.encoding)
+            out[f"{name}__{label}"] = entry
+    return ds.drop_vars(split).assign(out)
+
+
+def open_dataset(path, **kwargs) -> xr.Dataset:
+    """Open a NetCDF file that stabdae wrote, as the dataset that was written: the
+    variables :func:`write_netcdf` stored one entry at a time (``x__theta``, …, each with
+    its own ``units``) stacked again into ``x`` along its entry dimension, with
+    ``units_per_component`` naming the coordinate that holds each entry's unit.
+    ``kwargs`` go to ``xarray.open_dataset``; a file without such variables opens as
+    xarray opens it."""
+    ds = xr.open_dataset(path, **kwargs)
+    groups: dict[str, list[str]] = {}
+    for name, var in ds.data_vars.items():
+        if "stacked_from" in var.attrs:
+            groups.setdefault(var.attrs["stacked_from"], []).append(name)
+    stacked = {}
+    for name, parts in groups.items():
+        head = ds[parts[0]].attrs
+        dim = head["stacked_along"]
+        labels = [str(v) for v in ds[dim].values]
+        by_label = {n.removeprefix(f"{name}__"): n for n in parts}
+        if sorted(by_label) != sorted(labels):
+            raise ValueError(f"stabdae.open_dataset: {path}: the entries of {name!r} on disk "
+                             f"({sorted(by_label)}) are not those of {dim!r} ({labels})")
+        entries = [ds[by_label[label]].variable for label in labels]
+        var = xr.Variable.concat(entries, dim)
+        order = list(entries[0].dims)
+        order.insert(int(head["stacked_axis"]), dim)
+        var = var.transpose(*order)
+        attrs = {k: v for k, v in head.items() if k not in STACKED and k != "units"}
+        attrs["long_name"] = str(head["long_name"]).removesuffix(f": {labels[0]}")
+        attrs["units_per_component"] = head["stacked_units"]
+        var.attrs = attrs
+        # how the entries were stored (compression, type), not where or in what shape
+        var.encoding = {k: v for k, v in entries[0].encoding.items()
+                        if k not in ("chunksizes", "original_shape", "preferred_chunks",
+                                     "source")}  # fmt: skip
+        stacked[name] = var
+    if not stacked:
+        return ds
+    parts = [n for names in groups.values() for n in names]
+    out = ds.drop_vars(parts).assign(stacked)
+    out.set_close(ds.close)  # closing what is returned closes the file
+    return out
+
+
 #: variables of more than two dimensions and at least this many bytes are chunked by
 #: their leading indices (:func:`write_netcdf`)
 _CHUNK_BY_POINT = 1 << 20
@@ -673,7 +768,7 @@ _CHUNK_BY_POINT = 1 << 20
 
 def _write_netcdf(ds, path, compress, overwrite) -> Path:
     path = Path(path)
-    ds = _cf_encoded(ds)
+    ds = split_entries(_cf_encoded(ds))
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")
     path.parent.mkdir(parents=True, exist_ok=True)

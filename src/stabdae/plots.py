@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ._schema import open_dataset
 from ._version import __version__
 
 __all__ = ["plot_dataset", "stability_map", "decision_map", "decay_curves",
@@ -369,7 +370,7 @@ def plot_dataset(dataset, output=None) -> list[Path]:
         if not src.is_file():
             raise FileNotFoundError(f"stabdae plot: no such dataset: {src}")
         try:
-            ds = xr.open_dataset(src).load()
+            ds = open_dataset(src).load()
         except (ValueError, OSError) as exc:  # not NetCDF: xarray names its backends instead
             first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise ValueError(f"stabdae plot: {src} is not a NetCDF dataset that xarray can "

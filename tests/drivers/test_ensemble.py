@@ -140,7 +140,7 @@ def test_dataset_schema_and_round_trip(tmp_path):
     assert ds.attrs["residual_norm_dtype"] == "float32"
     assert ds.attrs["fused_multiply_add"] == int(HOST_FMA)
     path = write_netcdf(ds, tmp_path / "ens.nc")
-    with xr.open_dataset(path) as back:
+    with stabdae.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), ds)
         for name in ("residual_norm", "x0", "beta"):  # zlib-compressed, shuffled
             enc = back[name].encoding

@@ -44,7 +44,7 @@ def test_netcdf_round_trip(tmp_path):
                            1e-3, 0.5, 0.01)  # fmt: skip
     path = write_netcdf(ds, tmp_path / "sub" / "sleigh.nc")
     assert sorted(p.name for p in path.parent.iterdir()) == ["sleigh.nc"]  # no temporary left
-    with xr.open_dataset(path) as back:
+    with stabdae.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), ds)
         assert back.x.encoding.get("zlib") is True and back.residual.encoding.get("zlib") is True
     with pytest.raises(FileExistsError, match="exists"):

@@ -55,7 +55,7 @@ def test_every_dataset_has_valid_units_history_and_one_time_format(tmp_path):
     for ds in datasets:
         assert_schema(ds)
     ens = datasets[3]
-    assert ens.residual_norm.attrs["units_per_component"] == "component_units"
+    assert ens.residual_norm.attrs["units"] == "1"  # f in m², ḟ in m² s-1: each divided
     assert ens.beta.attrs["units"] == "s-1"
     # a model whose constraints share one unit: the norms carry it
     sl = datasets[5]
@@ -118,8 +118,8 @@ def test_units_follow_from_the_models_declared_units():
     """Dimensional analysis of every schema variable for the Chaplygin sleigh (a velocity
     constraint in m s-1, coordinates in m and rad, energy in J) and the pendulum (a
     position constraint in m², energy per mass in m² s-2): rates are per second, times
-    in seconds, residual norms in the unit of g's components (none where f and ḟ differ:
-    then per component), energies in the energy's, the
+    in seconds, residual norms in the unit of g's components (where f and ḟ differ, the
+    norm of g with each component divided by its unit: 1), energies in the energy's, the
     rest pure numbers; per entry, a velocity is its coordinate per second, ḟ is f per
     second, an acceleration its coordinate per second squared, and a multiplier makes
     ``Fᵀλ`` a generalized force: energy per unit of f, or per unit of h and second (a
@@ -154,7 +154,7 @@ def test_units_follow_from_the_models_declared_units():
                 continue
             units = attrs.get("units")
             if name in RESIDUALS and common is None:
-                assert units is None, name
+                assert units == "1" and "units_per_component" not in attrs, name
                 continue
             want = (per_s if name in RATES else {"s": 1} if name in TIMES
                     else common if name in RESIDUALS else energy if name in ENERGIES
@@ -164,20 +164,20 @@ def test_units_follow_from_the_models_declared_units():
 
 
 def test_a_norm_over_components_of_different_units_says_so():
-    """The pendulum's residual norm runs over f (m²) and ḟ (m² s-1): no single unit, the
-    per-component coordinate named, and a comment saying which unit the norm is in, kept
-    beside a comment the variable already has; the sleigh's (one unit) has neither."""
-    from stabdae._schema import schema_variable
+    """The pendulum's residual norm runs over f (m²) and ḟ (m² s-1): it is the norm of g
+    with each component divided by its unit, a pure number (units "1"), and its comment
+    says so, kept beside a comment the variable already has; the sleigh's (one unit)
+    has the constraints' unit and no such comment."""
+    from stabdae._schema import MIXED_NORM, schema_variable
 
     pend, sleigh = load_scene("pendulum"), load_scene("chaplygin_sleigh")
     norm = schema_variable("residual_norm", 0.0, pend, dims=()).attrs
     gamma = schema_variable("gamma", 0.0, pend, dims=()).attrs
-    assert "units" not in norm and norm["units_per_component"] == "component_units"
-    assert norm["comment"].startswith("NaN after a member stopped; max over residual "
-                                      "components of different units")  # fmt: skip
-    assert gamma["comment"].startswith("max over residual components of different units")
+    assert norm["units"] == "1" and "units_per_component" not in norm
+    assert norm["comment"] == f"NaN after a member stopped; {MIXED_NORM}"
+    assert gamma["units"] == "1" and gamma["comment"] == MIXED_NORM
     one = schema_variable("residual_norm", 0.0, sleigh, dims=()).attrs
-    assert one["units"] == "m s-1" and "different units" not in one.get("comment", "")
+    assert one["units"] == "m s-1" and MIXED_NORM not in one.get("comment", "")
 
 
 def test_write_netcdf_compresses_the_numeric_arrays_at_the_level_asked(tmp_path):
@@ -265,6 +265,64 @@ def cf_findings(path) -> set:
             for msg in item["msgs"]}  # fmt: skip
 
 
+def numeric_without_one_unit(path) -> list[str]:
+    """The numeric variables of the file ``path`` (read with netCDF4, as a CF tool reads
+    it) that have no ``units``, or carry ``units_per_component``."""
+    import netCDF4
+
+    with netCDF4.Dataset(path) as nc:
+        return [v.name for v in nc.variables.values() if v.dtype != str
+                and np.dtype(v.dtype).kind in "fiu"
+                and ("units" not in v.ncattrs() or "units_per_component" in v.ncattrs())]
+
+
+def test_files_have_one_unit_per_variable_and_open_as_written(tmp_path):
+    """CF gives a variable one unit and reads one without units as a pure number: in a
+    file ``stabdae.write_netcdf`` wrote, every numeric variable has ``units``, a variable
+    whose entries mix units (the pendulum's x in m and m s-1, its residual, alpha0, x0,
+    x_final; the sleigh's accelerations in m s-2 and rad s-2) stored one entry per
+    variable with that entry's unit and values; ``stabdae.open_dataset`` gives back the
+    dataset that was written, identical.  Before: ``x``, ``residual``, ``alpha0`` and
+    every mixed norm had no ``units``."""
+    import netCDF4
+
+    model = pendulum_scene()
+    law = stabdae.baumgarte(10.0)
+    datasets = {
+        "trajectory": stabdae.integrate(model, None, law, "rk4", 1e-3, 0.1, 0.01,
+                                        with_multipliers=True),
+        "ensemble": stabdae.ensemble(model, law, "rk4", 1e-3, 0.1, members=8, save_dt=0.01,
+                                     states=True),
+        "sleigh": stabdae.integrate(load_scene("chaplygin_sleigh"), None,
+                                    stabdae.theorem5(2.0), "rk4", 1e-3, 0.1, 0.01,
+                                    with_multipliers=True),
+    }  # fmt: skip
+    for kind, ds in datasets.items():
+        path = stabdae.write_netcdf(ds, tmp_path / f"{kind}.nc")
+        assert numeric_without_one_unit(path) == [], kind
+        stacked = [n for n, v in ds.data_vars.items() if "units_per_component" in v.attrs]
+        assert set(stacked) == {"trajectory": {"x", "residual"},
+                                "ensemble": {"alpha0", "x0", "x_final"},
+                                "sleigh": {"x", "acceleration"}}[kind]  # fmt: skip
+        with netCDF4.Dataset(path) as nc:
+            for name in stacked:
+                var = ds[name]
+                dim = ds[var.attrs["units_per_component"]].dims[0]
+                units = ds[var.attrs["units_per_component"]].values
+                assert name not in nc.variables
+                for i, label in enumerate(ds[dim].values):
+                    entry = nc[f"{name}__{label}"]
+                    assert entry.units == units[i] and entry.stacked_from == name
+                    np.testing.assert_array_equal(entry[:].filled(np.nan),
+                                                  var.isel({dim: i}).values)  # fmt: skip
+        xr.testing.assert_identical(stabdae.open_dataset(path).load(), ds)
+        # a file of another writer opens as xarray opens it
+        other = tmp_path / f"{kind}-xarray.nc"
+        ds.to_netcdf(other)
+        xr.testing.assert_identical(stabdae.open_dataset(other).load(),
+                                    xr.open_dataset(other).load())  # fmt: skip
+
+
 def test_every_kind_of_dataset_passes_the_cf_checker(tmp_path):
     """The IOOS compliance checker (CF 1.10) on a trajectory and an ensemble written by
     their own ``to_netcdf`` (as a user writes them) and on a study's dataset: no finding
@@ -294,3 +352,10 @@ def test_every_kind_of_dataset_passes_the_cf_checker(tmp_path):
         assert ds.members_used.values.tolist() != [64, 64]  # (the padding is checked too)
     for path in (traj, ens, study, seq):
         assert cf_findings(path) == CF_ACCEPTED, path.name
+    # a study's file has one unit per variable (its alpha0 one variable per entry)
+    for path in (study, seq):
+        assert numeric_without_one_unit(path) == [], path.name
+        with xr.open_dataset(path) as ds:
+            assert "alpha0__f_0" in ds and "alpha0" not in ds
+        with stabdae.open_dataset(path) as ds:
+            assert ds.alpha0.dims[-1] == "component"
