@@ -31,6 +31,11 @@ settings.register_profile("mutation", parent=settings.get_profile("stabdae"),
                           phases=[Phase.explicit, Phase.reuse, Phase.generate])  # fmt: skip
 settings.load_profile(os.environ.get("STABDAE_HYPOTHESIS_PROFILE", "stabdae"))
 
+#: no helper process compiling a new model's sampler ahead (``stabdae.engine.ahead``): the
+#: suite's workers already keep every CPU busy, and several tests count what a process
+#: compiled itself; the helper's own tests switch it on
+os.environ.setdefault("STABDAE_COMPILE_AHEAD", "0")
+
 _approx = pytest.approx
 
 

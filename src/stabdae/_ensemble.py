@@ -30,6 +30,7 @@ from ._model import Model
 from ._raised import first_raising_member, model_raised, stage_finder
 from ._schema import schema_entry
 from ._sequential import Sequential, decide
+from .engine.ahead import sampler_ahead
 from .engine.crash import guard
 from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
@@ -779,7 +780,20 @@ def _members(run: _RunSpec, x0, reference: bool = True):
                           run.start)  # fmt: skip
     if not reference:
         return (*_place(model, targets, p, t0, run.threads), None)
-    if run.adaptive or run.mode.kernel.signatures:
+    ahead = sampler_ahead(model, sampler_for(model), run.mode.kernel)
+    if ahead is not None:
+        # a helper process compiles the sampler while this one compiles the kernel (in
+        # the reference's first call); the placing then loads the sampler from the cache
+        try:
+            clock = time.perf_counter()
+            g_ref = run.mode.reference(run)
+            # the sampler is the smaller kernel: a helper not done after as long again is
+            # stopped (the placing then compiles the sampler here)
+            ahead.join(max(5.0, time.perf_counter() - clock))
+        finally:
+            ahead.stop()
+        x0, alpha0, status = _place(model, targets, p, t0, run.threads)
+    elif run.adaptive or run.mode.kernel.signatures:
         x0, alpha0, status = _place(model, targets, p, t0, run.threads)
         g_ref = run.mode.reference(run)
     else:

@@ -165,6 +165,8 @@ def load_model(source, attribute: str = "model") -> Model:
             f"load_model: {path} must define a module-level stabdae.Model named "
             f"{attribute!r}; found {type(model).__name__}"
         )
+    # where another process finds the same model (a helper compiling its sampler ahead)
+    model._origin = (str(path), attribute)
     return model
 
 

@@ -40,6 +40,8 @@ CHILD = textwrap.dedent(
     print(json.dumps(dict(
         hits=sum(sum(k.stats.cache_hits.values()) for k in kernels),
         misses=sum(sum(k.stats.cache_misses.values()) for k in kernels),
+        sampler=[sum(kernels[0].stats.cache_hits.values()),
+                 sum(kernels[0].stats.cache_misses.values())],
         seconds=first,
         x_final=ds.x_final.values.tolist(),
     )))
@@ -47,8 +49,9 @@ CHILD = textwrap.dedent(
 )
 
 
-def _child(model_file: Path, cache: Path) -> dict:
-    env = dict(os.environ, STABDAE_CACHE_DIR=str(cache), PYTHONPATH=str(SRC))
+def _child(model_file: Path, cache: Path, ahead: str = "0") -> dict:
+    env = dict(os.environ, STABDAE_CACHE_DIR=str(cache), PYTHONPATH=str(SRC),
+               STABDAE_COMPILE_AHEAD=ahead)  # fmt: skip
     out = subprocess.run([sys.executable, "-c", CHILD, str(model_file)], env=env, check=True,
                          capture_output=True, text=True, timeout=300)  # fmt: skip
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -74,6 +77,61 @@ def test_second_process_loads_the_kernels_and_an_edit_recompiles(tmp_path):
     third = _child(model_file, cache)
     assert third["hits"] == 0 and third["misses"] == 2
     assert third["x_final"] == first["x_final"]
+
+
+def test_a_helper_process_compiles_the_sampler_while_the_kernel_compiles(tmp_path):
+    """A new model's first ensemble, with two CPUs and the kernel cache: a helper process
+    compiles the sampler into the cache while the ensemble compiles its kernel, and the
+    ensemble loads the sampler from there (one hit, no miss; the kernel one miss).  The
+    numbers are those of a process that compiled both itself.  Without the helper (it
+    switched off) both are compiled here."""
+    from stabdae.engine.ahead import _usable_cpus
+
+    if _usable_cpus() < 2:
+        pytest.skip("the helper runs only with two usable CPUs")
+    model_file = tmp_path / "pendulum_ahead.py"
+    model_file.write_text((scene_dir() / "pendulum.py").read_text())
+    alone = _child(model_file, tmp_path / "alone")
+    assert alone["sampler"] == [0, 1] and alone["misses"] == 2
+    helped = _child(model_file, tmp_path / "helped", ahead="1")
+    assert helped["sampler"] == [1, 0] and helped["hits"] == 1 and helped["misses"] == 1
+    assert helped["x_final"] == alone["x_final"]
+    print(f"first ensemble alone {alone['seconds']:.2f} s, helped {helped['seconds']:.2f} s")
+
+
+def test_the_helper_starts_only_where_it_can_gain_and_a_failed_one_is_waited_out(
+        tmp_path, monkeypatch):  # fmt: skip
+    """No helper for a model not loaded from a file, with the cache or the helper switched
+    off, or a sampler already compiled; a helper that cannot load its model ends, and
+    ``join`` says it did not finish cleanly (the ensemble then compiles the sampler)."""
+    from stabdae._laws import bind_law
+    from stabdae.engine import ahead
+    from stabdae.engine.ensemble.block import ensemble_kernel_for
+    from stabdae.engine.sampler import sampler_for
+
+    monkeypatch.setattr(ahead, "_usable_cpus", lambda: 2)
+    monkeypatch.setenv("STABDAE_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv(ahead.ENV, "1")
+    model_file = tmp_path / "pendulum_guard.py"
+    model_file.write_text((scene_dir() / "pendulum.py").read_text())
+    model = stabdae.load_model(model_file)
+    assert model._origin == (str(model_file), "model")
+    sampler = sampler_for(model)
+    kernel = ensemble_kernel_for(model, bind_law(stabdae.baumgarte(10.0), model),
+                                 stabdae.midpoint(), 64)  # fmt: skip
+    assert ahead.enabled() and not ahead.on_disk(sampler) and not ahead.on_disk(kernel)
+    for env, value in ((ahead.ENV, "0"), ("STABDAE_CACHE_DIR", "off")):
+        with monkeypatch.context() as m:
+            m.setenv(env, value)
+            assert ahead.sampler_ahead(model, sampler, kernel) is None, env
+    monkeypatch.setattr(ahead, "_usable_cpus", lambda: 1)
+    assert ahead.sampler_ahead(model, sampler, kernel) is None
+    monkeypatch.setattr(ahead, "_usable_cpus", lambda: 2)
+    anonymous = model.replace()  # built in this process: no file to load it from
+    assert ahead.sampler_ahead(anonymous, sampler_for(anonymous), kernel) is None
+    model._origin = (str(model_file), "no_such_model")
+    helper = ahead.sampler_ahead(model, sampler, kernel)
+    assert helper is not None and helper.join(60) is False
 
 
 def _scaled(c):
