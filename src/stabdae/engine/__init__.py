@@ -27,5 +27,7 @@ one floor up do, once).  By role:
 * :mod:`.threads` — running ``nogil`` kernels over chunks of members on a thread pool;
 * :mod:`.crash` — what is printed when a compiled kernel crashes (segmentation fault);
 * :mod:`.cache` — the compile spec (:class:`.cache.Spec`), the per-model memo of the
-  compiled closures and their on-disk cache.
+  compiled closures and their on-disk cache;
+* :mod:`.ahead` — a new model's sampler compiled into that cache by a helper process while
+  this one compiles the ensemble kernel.
 """
