@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+import stabdae
 from conftest import KERNELS, ROOT
 from stabdae.study.cli import main
 
@@ -145,7 +146,7 @@ def test_integrate_with_rk3_and_with_a_tableau(tmp_path, capsys):
     heun = tmp_path / "heun.nc"
     assert main(["integrate", "pendulum", "--scheme", "heun", "--t-end", "0.2",
                  "-o", str(heun)]) == 0  # fmt: skip
-    with xr.open_dataset(out) as a, xr.open_dataset(heun) as b:
+    with stabdae.open_dataset(out) as a, stabdae.open_dataset(heun) as b:
         assert a.attrs["scheme"] == "custom"
         np.testing.assert_array_equal(a.x.values, b.x.values)  # the same tableau as Heun's
     assert main(["integrate", "pendulum", "--scheme", "rk3", "--t-end", "0.2",
