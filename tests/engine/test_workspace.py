@@ -1,5 +1,5 @@
 """The right-hand side's buffers follow one declaration on the heap and on the stack;
-the generated member step is visible and can be dumped."""
+generated source is visible and can be dumped."""
 
 from __future__ import annotations
 
@@ -12,9 +12,7 @@ from numba import literal_unroll, njit
 import stabdae
 from conftest import compiled_only, load_scene
 from stabdae._laws import bind_law
-from stabdae.engine.ensemble.block import ensemble_kernel_for
 from stabdae.engine.rhs import kernels_for
-from stabdae.engine.rk.steps import _member_step_source, tableau_pattern
 from stabdae.engine.workspace import LAYOUT, shapes
 
 
@@ -47,18 +45,19 @@ def test_heap_and_stack_workspaces_follow_one_declaration(name):
 
 
 # ---------------------------------------------------------------- generated source
-def test_generated_member_step_is_visible_and_can_be_dumped(tmp_path, monkeypatch):
-    """The member step's generated source is registered with linecache (inspect shows it),
+def test_generated_source_is_visible_and_can_be_dumped(tmp_path, monkeypatch):
+    """Source the library generates (here the adaptive ensemble's attempted step of
+    DOP853, for the pendulum's 2n = 4) is registered with linecache (inspect shows it),
     and STABDAE_DUMP_SOURCE writes it to a file."""
-    monkeypatch.setenv("STABDAE_DUMP_SOURCE", str(tmp_path))
-    model = load_scene("pendulum")
-    scheme = stabdae.two_stage(0.25, 2.0)  # every weight and stage coefficient 'other'
-    ensemble_kernel_for(model, bind_law(stabdae.baumgarte(10.0), model), scheme, 8)
-    source = _member_step_source(tableau_pattern(scheme), 4)  # the pendulum's 2n = 4
-    dumped = [p.read_text() for p in tmp_path.glob("member_step_*.py")]
-    assert source in dumped
-    from stabdae.engine.rk.steps import _member_step
+    from stabdae._schemes import embedded_pair
+    from stabdae.engine.rk.adaptive import _attempt_source, _pattern, attempt_for
 
-    step = _member_step(lambda *a: 0, 4, 2, tableau_pattern(scheme))
+    monkeypatch.setenv("STABDAE_DUMP_SOURCE", str(tmp_path))
+    ep = embedded_pair("dop853")
+    s, s_e = ep.scheme.stages, ep.error.shape[1]
+    source = _attempt_source(s, s_e, ep.combined, _pattern(ep), 4)
+    step = attempt_for(lambda *a: 0, s, s_e, ep.combined, _pattern(ep), 4, 2)
+    dumped = [p.read_text() for p in tmp_path.glob("adaptive_attempt_*.py")]
+    assert source in dumped
     assert inspect.getsource(step.py_func) == source
-    assert inspect.getsourcefile(step.py_func).startswith("<stabdae generated member_step")
+    assert inspect.getsourcefile(step.py_func).startswith("<stabdae generated adaptive_attempt")

@@ -1,25 +1,29 @@
 """The ensemble kernel: blocks of members in lockstep, structure of arrays, member innermost.
 
 Each work item (a block; ranges of blocks run on threads, :mod:`stabdae.engine.threads`)
-holds a block of ``BLOCK`` members as arrays ``X[state, member]`` on the stack. A step of
-the block is one loop over its members whose body is the member's whole explicit
-Runge–Kutta step (:func:`stabdae.engine.rk.steps._member_step_source`): the stages written
-out, each a call of the stabilized right-hand side (:mod:`stabdae.engine.rhs`, the user's
-functions inside), on buffers that live on the stack (:func:`stack1`, :func:`stack2`). The
-step is generated for the scheme's pattern of zero / one / other coefficients
-(:func:`stabdae.engine.rk.steps.tableau_pattern`): zero terms are left out, factors one
-dropped, the values stay run-time arrays.
+holds a block of ``BLOCK`` members as arrays ``X[state, member]`` on the stack.  A step of
+the block (``block_step``) goes stage by stage: the stage's argument for every member
+(one loop over the block's entries), then one loop over the members whose body is a call
+of the stabilized right-hand side (:mod:`stabdae.engine.rhs`, the user's functions inside)
+on buffers that live on the stack (:func:`stack1`, :func:`stack2`), then the weighted
+sum.  The right-hand side is inlined once, whatever the number of stages: written out per
+stage, as the step once was, each stage added the right-hand side's compile time again
+(the Whipple bicycle's kernel: 9.3 s with Euler, 13.1 s with the midpoint rule, 19.6 s
+with RK4; stage by stage 10.2, 10.8 and 10.9 s).  The scheme's coefficients are run-time
+arrays and zero coefficients are skipped at run time, so one kernel serves every tableau
+of its number of stages.
 
-Every function of the step is compiled once and marked ``alwaysinline`` for LLVM
+The pieces of the step are compiled once and marked ``alwaysinline`` for LLVM
 (``forceinline=True``) rather than inlined at the numba IR level (``inline="always"``):
-numba re-types the whole caller for each IR-inlined call site, which made the compile time
-grow with the number of stages (several times longer for RK4), while LLVM inlines the
-compiled bodies in a fraction of that.  With no calls, no heap arrays and no
-branches left in the loop body (the pivot tests of L D Lᵀ and the step's status are
-arithmetic: a chain of branches on them kept LLVM from vectorizing), and every array the
-loop touches an alloca that no other pointer reaches (the parameters, the law's numbers
-and the tableau are copied to the stack first), LLVM keeps the buffers in registers and
-vectorizes the member loop without run-time alias checks.
+numba re-types the whole caller for each IR-inlined call site, while LLVM inlines the
+compiled bodies in a fraction of that.  The block step itself, called once, is inlined
+by numba, so that its loops are optimized where LLVM sees the block's buffers as the
+kernel's own allocas.  With no calls, no heap arrays and no branches left in the member
+loop's body (the pivot tests of L D Lᵀ and the step's status are arithmetic: a chain of
+branches on them kept LLVM from vectorizing), and every array the loop touches an alloca
+that no other pointer reaches (the parameters, the law's numbers and the tableau are
+copied to the stack first), LLVM keeps the buffers in registers and vectorizes the member
+loop without run-time alias checks.
 
 The library's own multiply-adds are fused (:mod:`stabdae.engine.fma`) at the same places as in
 :func:`stabdae.integrate`'s step.  Members never interact, so results are bit-for-bit the
@@ -80,9 +84,9 @@ from ..decay import (
     spectral_radius_of,
     windows_flush,
 )
+from ..fma import fma
 from ..jit import internal
 from ..rhs import kernels_for
-from ..rk.steps import _member_step, tableau_pattern
 from ..workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 
 BLOCK = 64
@@ -157,21 +161,24 @@ BUFFERS = {
     "nlev": ("stack_int1(B)", "the level at this state"),
     "wmax": ("stack1(B)", "the largest ‖g‖ of the fifth so far"),
     "dmax": ("stack1(B)", "... of the measured norm"),
+    # the block step's
+    "XS": ("stack2(N2, B)", "a stage's argument, then the weighted sum of the stages"),
+    "KS": ("stack2(SN2, B)", "the stages' right-hand sides (stage s: rows s·N2 …)"),
+    "GS": ("stack2(ng, B)", "the residual a stage's right-hand side evaluated"),
+    "cm": ("stack_int1(B)", "each slot's worst stage status in the step"),
     # inside the member loop: per slot, on the stack (LLVM keeps them in registers)
     "ws": ("stack_workspace()", "the right-hand side's workspace"),
     "xs": ("stack1(N2)", "a stage's state (block_norms: the slot's state)"),
+    "ks": ("stack1(N2)", "the stage's right-hand side"),
     "gj": ("stack1(ng)", "block_norms: the slot's residual"),
-    "xk": ("stack1(N2)", "the slot's state before the step"),
-    "xn": ("stack1(N2)", "... after it"),
-    "gv": ("stack1(ng)", "the residual the step's first stage evaluated"),
 }
 
 
 def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
-    """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the kinds of
-    the scheme's coefficients, block, the shape of the law's matrix and whether the decay
+    """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the scheme's
+    number of stages, block, the shape of the law's matrix and whether the decay
     measurement pools the constraints, :func:`pooled_constraints`)."""
-    spec = Spec("block", law=bound.code, law_fn=bound.fn, pattern=tableau_pattern(scheme),
+    spec = Spec("block", law=bound.code, law_fn=bound.fn, stages=(len(scheme.b),),
                 block=block, n_params=len(model.param_names), law_shape=bound.matrix.shape,
                 pooled=pooled_constraints(model, bound.law))  # fmt: skip
     return memo(model, spec, lambda: build_block_kernel(kernels_for(model, bound), spec))
@@ -243,22 +250,23 @@ def block_failed(X, code):
 
 def build_block_kernel(K, spec: Spec):
     """The block-lockstep ensemble kernel for the kernels ``K`` and the compile spec
-    ``spec``: an explicit scheme whose coefficients are of the kinds ``spec.pattern``
-    (:func:`tableau_pattern`), blocks of ``spec.block`` members, ``spec.n_params``
+    ``spec``: an explicit scheme of ``spec.stages[0]`` stages, blocks of ``spec.block``
+    members, ``spec.n_params``
     parameters, a law matrix of shape ``spec.law_shape`` and the decay measurement's
     one-step map pooled over ``spec.pooled`` holonomic constraints (−1: the full map;
     :func:`.decay.map_width`), all fixed at compile time; the scheme's coefficients, the
     parameters and the law's numbers are run-time arrays (:mod:`.groups`)."""
-    pattern, block, n_params = spec.pattern, spec.block, spec.n_params
+    block, n_params = spec.block, spec.n_params
     law_shape, pooled = spec.law_shape, spec.pooled
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
     N2, ng = 2 * K.n, K.ng
     B = block
-    S_ = len(pattern[1])
+    S_ = spec.stages[0]
+    SN2 = S_ * N2
+    NB = N2 * B  # the entries of the block's state
     NP = max(n_params, 1)
     LR, LC = law_shape
-    member_step = _member_step(rhs, N2, ng, pattern)
     stack_workspace = K.stack_workspace
     ROWS_FULL = full_rows(ng)
     FULL = ng if ng <= MAP_MAX_NG else 0  # the full map's components (none: 0)
@@ -287,6 +295,63 @@ def build_block_kernel(K, spec: Spec):
                 G[l, j] = gj[l]
             nrm[j] = s
             dnrm[j] = d
+
+    # inlined by numba (its one call): its loops are optimized where LLVM sees that the
+    # block's buffers are distinct allocas (compiled on its own, the slot loop was
+    # vectorized behind run-time alias checks, with a scalar copy of the right-hand side)
+    @njit(inline="always", error_model="numpy")
+    def block_step(X, t, tau, p, lm, ls, ta, tb, tc, XS, KS, GS, cm, code, Dv):
+        """One explicit Runge–Kutta step of every slot of the block, stage by stage: each
+        stage's argument, then its right-hand side for every slot (one loop over the
+        slots: the right-hand side is inlined once, whatever the number of stages), then
+        the weighted sum.  The operations of :func:`stabdae.integrate`'s step, in its
+        order (zero coefficients skipped, sums from −0.0): the same bits.  Each slot's
+        status, the worst of its stages, is ORed into ``code``; the residual at the
+        step's start (the first stage's) goes to ``Dv``.  The sums run over the block's
+        buffers as flat arrays: one loop each, which LLVM vectorizes without writing it
+        out (over ``X[l, j]`` for each ``l``, it wrote out all ``N2 · B`` entries of each
+        sum, more code than the right-hand side's)."""
+        S = tb.shape[0]  # (a run-time count: LLVM does not copy the stage loop per stage)
+        Xf = X.reshape(NB)
+        XSf = XS.reshape(NB)
+        KSf = KS.reshape(S_ * NB)
+        for j in range(B):
+            cm[j] = 0
+        for s in range(S):
+            for i in range(NB):
+                XSf[i] = Xf[i]
+            for q in range(s):
+                if ta[s, q] != 0.0:
+                    c = tau * ta[s, q]
+                    for i in range(NB):
+                        XSf[i] = fma(c, KSf[q * NB + i], XSf[i])
+            ts = t + tc[s] * tau
+            for j in range(B):  # the stage of every slot
+                ws = stack_workspace()
+                xs = stack1(N2)
+                ks = stack1(N2)
+                for l in range(N2):
+                    xs[l] = XS[l, j]
+                st = rhs(ts, xs, p, lm, ls, ws, ks)
+                for l in range(N2):
+                    KS[s * N2 + l, j] = ks[l]
+                cm[j] = max(cm[j], st)
+                for l in range(ng):
+                    GS[l, j] = ws.g[l]
+            if s == 0:
+                for l in range(ng):
+                    for j in range(B):
+                        Dv[l, j] = GS[l, j]
+        for i in range(NB):
+            XSf[i] = -0.0
+        for s in range(S):
+            if tb[s] != 0.0:
+                for i in range(NB):
+                    XSf[i] = fma(tb[s], KSf[s * NB + i], XSf[i])
+        for i in range(NB):
+            Xf[i] = fma(tau, XSf[i], Xf[i])
+        for j in range(B):
+            code[j] |= cm[j]
 
     @njit(nogil=True, error_model="numpy")
     def block_kernel(inputs, grid, tableau, measure, out, b_lo, b_hi):
@@ -330,6 +395,10 @@ def build_block_kernel(K, spec: Spec):
         # slot's steps since then.
         X = stack2(N2, B)
         Xc = stack2(N2, B)
+        XS = stack2(N2, B)  # a stage's argument, then the weighted sum of the stages
+        KS = stack2(SN2, B)  # the stages' right-hand sides (stage s: rows s·N2 …)
+        GS = stack2(ng, B)  # the residual a stage's right-hand side evaluated
+        cm = stack_int1(B)  # each slot's worst stage status in the step
         code = stack_int1(B)
         active = stack_int1(B)  # members (not padding) still running: 1, else 0
         ws_h = K_make_workspace()
@@ -436,20 +505,7 @@ def build_block_kernel(K, spec: Spec):
                 if has_ref:
                     for l in range(ng):
                         gr[l] = g_ref[i - 1, l]
-                for j in range(B):  # the whole step of every member
-                    ws = stack_workspace()
-                    xk = stack1(N2)
-                    xs = stack1(N2)
-                    xn = stack1(N2)
-                    gv = stack1(ng)
-                    for l in range(N2):
-                        xk[l] = X[l, j]
-                    c = member_step(t, xk, tau, p_s, lm, ls, ta, tb, tc, ws, xs, xn, gv)
-                    for l in range(N2):
-                        X[l, j] = xn[l]
-                    code[j] |= c
-                    for l in range(ng):
-                        Dv[l, j] = gv[l]
+                block_step(X, t, tau, p_s, lm, ls, ta, tb, tc, XS, KS, GS, cm, code, Dv)
                 if has_out:  # g(x_{i-1}), evaluated by the step's first stage
                     for l in range(ng):
                         g_out[i - 1, l] = Dv[l, 0]
@@ -547,6 +603,8 @@ def build_block_kernel(K, spec: Spec):
                             rho_R)  # fmt: skip
 
     key = spec.key(K.key)
-    tag(key, block_norms, member_step, pairs_full,
+    tag(key, block_norms, block_step, pairs_full,
         *((bin_flush, end_flush) if FULL and pooled < 0 else ()))  # (closures only)
-    return keyed_cache(block_kernel, key)
+    kernel = keyed_cache(block_kernel, key)
+    kernel.block_step = block_step  # (compiled inside the kernel; a test compiles it apart)
+    return kernel
