@@ -17,7 +17,8 @@ strictly lower-triangular ``A``, Butcher's order conditions for every rooted tre
 the declared order, and not beyond it) are asserted when it is made; an embedded pair
 checks its error estimates' orders the same way.  The single-trajectory loops read the
 tableau as run-time arrays, so a new scheme compiles nothing there; the ensemble kernel is
-compiled once per pattern of zero, unit and other coefficients.
+compiled once per pattern of zero, unit and other coefficients (per number of stages for
+schemes of three stages or more on models of six coordinates or more).
 """
 
 from __future__ import annotations

@@ -170,10 +170,24 @@ def _scheme(spec):
         return stabdae.two_stage(*spec)
 
 
+@pytest.fixture(params=["written out", "by stage"])
+def step_form(request, monkeypatch):
+    """Both forms of the ensemble kernel's block step on the same small model: each
+    member's stages written out (the pendulum's own) and stage by stage (the form of
+    larger models under schemes of three stages or more, forced here)."""
+    from stabdae.engine.ensemble import block
+
+    if request.param == "by stage":
+        monkeypatch.setattr(block, "STAGE_LOOP_MIN_N", 0)
+        monkeypatch.setattr(block, "STAGE_LOOP_MIN_STAGES", 0)
+    return request.param
+
+
 @pytest.mark.parametrize("spec", ["euler", "midpoint", "rk4", "dop853", (0.3, 0.0), (0.25, 2.0)])
-def test_block_step_and_looped_step_agree_for_every_tableau_pattern(spec):
-    """The ensemble kernel steps the block stage by stage, skipping zero coefficients at
-    run time; its numbers are those of ``integrate`` bit for bit
+def test_block_step_and_looped_step_agree_for_every_tableau_pattern(spec, step_form):
+    """The ensemble kernel's step, with each member's stages written out for the pattern
+    of the coefficients or stage by stage (zero coefficients skipped at run time): its
+    numbers are those of ``integrate`` bit for bit
     (σ = 0 has a zero weight, σ = 2 two general ones, DOP853 twelve stages and zeros
     inside A and b; dopri5's pattern is covered below)."""
     scheme = _scheme(spec)
@@ -187,14 +201,16 @@ def test_block_step_and_looped_step_agree_for_every_tableau_pattern(spec):
                                       one.residual_norm.values.astype(np.float32))  # fmt: skip
 
 
-def test_a_tableau_of_many_stages_runs_bit_for_bit():
-    """A tableau of 40 stages (written out per stage, as the kernel once was, it compiled
-    for 14 minutes; the kernel now loops over the stages, whatever their number): the
-    numbers are still ``integrate``'s bit for bit, with zeros, ones and other values in A
-    and b (skipped, exact, fused)."""
+def test_a_tableau_of_many_stages_runs_bit_for_bit(step_form):
+    """A tableau of 40 stages (written out per stage it compiled for 14 minutes: above
+    ``WRITTEN_MAX_STAGES`` a member's stages are looped, and stage by stage the block's
+    are): the numbers are still ``integrate``'s bit for bit, with zeros, ones and other
+    values in A and b (skipped, exact, fused)."""
     from stabdae._schemes import from_tableau, tableau_order
+    from stabdae.engine.rk.steps import WRITTEN_MAX_STAGES
 
     s = 40
+    assert s > WRITTEN_MAX_STAGES
     rng = np.random.default_rng(3)
     A = np.tril(rng.uniform(0.0, 0.05, (s, s)), -1)
     A[rng.random((s, s)) < 0.3] = 0.0
@@ -218,7 +234,7 @@ def test_a_tableau_of_many_stages_runs_bit_for_bit():
 
 
 @pytest.mark.parametrize("spec", ["rk4", "dopri5"])
-def test_block_step_and_looped_step_agree_on_stage_times(spec):
+def test_block_step_and_looped_step_agree_on_stage_times(spec, step_form):
     """On time-dependent constraints (the pendulum of prescribed length) the
     stage times t + c·τ matter: the ensemble kernel's block step gives the numbers of
     ``integrate`` bit for bit.  The stage times are formed alike for every pattern of

@@ -33,6 +33,8 @@ class Mutant:
 
 
 E = "src/stabdae/engine/"
+#: the ensemble-against-integrate test on a time-dependent model, per form of the step
+STAGE_TIMES = "tests/drivers/test_ensemble.py::test_block_step_and_looped_step_agree_on_stage_times"
 S = "src/stabdae/"
 
 #: the tests that read the decay rate from the one-step map
@@ -285,13 +287,20 @@ MUTANTS = [
             'tests/engine/test_decay.py::test_log_prefactor_fit_outside_the_normal_range_is_least_squares',
             'tests/engine/test_decay.py::test_no_transient_or_growth_gives_no_rate_and_says_why'),
            "β fit's lead fraction set to 0"),
+    Mutant("member-step-no-stage-time",
+           E + "rk/steps.py",
+           'f"    c{s} = rhs(t + tab_c[{s}] * tau, {arg},',
+           'f"    c{s} = rhs(t, {arg},',
+           (STAGE_TIMES + "[written out-rk4]",
+            STAGE_TIMES + "[written out-dopri5]"),
+           "generated ensemble step drops the stage time c·τ"),
     Mutant("block-step-no-stage-time",
            E + "ensemble/block.py",
            "ts = t + tc[s] * tau",
            "ts = t",
-           ('tests/drivers/test_ensemble.py::test_block_step_and_looped_step_agree_on_stage_times[rk4]',
-            'tests/drivers/test_ensemble.py::test_block_step_and_looped_step_agree_on_stage_times[dopri5]'),
-           "the ensemble's block step drops the stage time c·τ"),
+           (STAGE_TIMES + "[by stage-rk4]",
+            STAGE_TIMES + "[by stage-dopri5]"),
+           "the ensemble's stage-by-stage block step drops the stage time c·τ"),
     Mutant("reference-residual-time",
            E + "ensemble/block.py",
            "g_out[nsteps, l] = Gb[l, 0]",

@@ -1,10 +1,11 @@
 """Source code that the library generates and compiles, made visible.
 
-The ensemble kernel's member step and the workspace builders are Python source written
-for one model's sizes and one scheme's pattern of coefficients, then compiled.  Each piece
-is registered with :mod:`linecache` under a readable name (``<stabdae generated
-member_step 1a2b3c4d5e6f>``), so that tracebacks show its lines and
-:func:`inspect.getsource` returns it.  With ``STABDAE_DUMP_SOURCE=FOLDER`` in the
+The ensemble kernel's member step, the adaptive ensemble's attempted step, the workspace
+builders and the written-out linear algebra are Python source written for one model's
+sizes (and one scheme's pattern of coefficients), then compiled.  Each piece is
+registered with :mod:`linecache` under a readable name (``<stabdae generated member_step
+1a2b3c4d5e6f>``), so that tracebacks show its lines and :func:`inspect.getsource` returns
+it.  With ``STABDAE_DUMP_SOURCE=FOLDER`` in the
 environment every piece is also written to ``FOLDER/<label>-<digest>.py`` as it is
 generated, for reading or stepping through with ``NUMBA_DISABLE_JIT=1``.
 """

@@ -2,16 +2,28 @@
 
 Each work item (a block; ranges of blocks run on threads, :mod:`stabdae.engine.threads`)
 holds a block of ``BLOCK`` members as arrays ``X[state, member]`` on the stack.  A step of
-the block (``block_step``) goes stage by stage: the stage's argument for every member
-(one loop over the block's entries), then one loop over the members whose body is a call
-of the stabilized right-hand side (:mod:`stabdae.engine.rhs`, the user's functions inside)
-on buffers that live on the stack (:func:`stack1`, :func:`stack2`), then the weighted
-sum.  The right-hand side is inlined once, whatever the number of stages: written out per
-stage, as the step once was, each stage added the right-hand side's compile time again
-(the Whipple bicycle's kernel: 9.3 s with Euler, 13.1 s with the midpoint rule, 19.6 s
-with RK4; stage by stage 10.2, 10.8 and 10.9 s).  The scheme's coefficients are run-time
-arrays and zero coefficients are skipped at run time, so one kernel serves every tableau
-of its number of stages.
+the block takes one of two forms, the same operations in the same order:
+
+* for a scheme of ``STAGE_LOOP_MIN_STAGES`` stages or more on a model of
+  ``STAGE_LOOP_MIN_N`` coordinates or more, stage by stage (``block_step``): the stage's
+  argument for every member (one loop over the block's entries), then one loop over the
+  members whose body is a call of the stabilized
+  right-hand side (:mod:`stabdae.engine.rhs`, the user's functions inside) on buffers
+  that live on the stack (:func:`stack1`, :func:`stack2`), then the weighted sum.  The
+  right-hand side is inlined once, whatever the number of stages: written out per stage,
+  each stage added the right-hand side's compile time again (the Whipple bicycle's
+  kernel: 9.3 s with Euler, 13.1 s with the midpoint rule, 19.6 s with RK4; stage by
+  stage 10.2, 10.8 and 10.9 s).  Zero coefficients are skipped at run time, so one
+  kernel serves every tableau of its number of stages;
+* otherwise, one loop over the members whose body is the member's whole step
+  (``member_loop_step``, :func:`stabdae.engine.rk.steps._member_step_source`): the stages
+  written out for the scheme's pattern of zero / one / other coefficients
+  (:func:`stabdae.engine.rk.steps.tableau_pattern`), zero terms left out, factors one
+  dropped.  The stages stay in registers: stage by stage, through the block's buffers
+  in memory, the pendulum's midpoint ensemble integrated 36 % slower and the
+  12-coordinate bicycle's 12 %; a small right-hand side compiles quickly once per stage.
+
+The scheme's coefficients are run-time arrays in both.
 
 The pieces of the step are compiled once and marked ``alwaysinline`` for LLVM
 (``forceinline=True``) rather than inlined at the numba IR level (``inline="always"``):
@@ -87,9 +99,21 @@ from ..decay import (
 from ..fma import fma
 from ..jit import internal
 from ..rhs import kernels_for
+from ..rk.steps import _member_step, tableau_pattern
 from ..workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 
 BLOCK = 64
+#: schemes of at least ``STAGE_LOOP_MIN_STAGES`` stages on models of at least
+#: ``STAGE_LOOP_MIN_N`` coordinates step the block stage by stage (``block_step``: the
+#: right-hand side inlined once, whatever the stages); the others step each member through
+#: its stages written out (``member_loop_step``), whose copies of the right-hand side keep
+#: the stages in registers.  Stage by stage, integrating took 36 % longer for the
+#: pendulum's midpoint ensemble, 80 % for the double pendulum's (its RK4 23 %), 12 % for
+#: the 12-coordinate bicycle's midpoint, 1–5 % for the bicycle's and n_four_bar's RK4;
+#: written out, each stage beyond the first adds the right-hand side's compile time again
+#: (the bicycle's RK4 kernel: 19.6 s against 10.9 s stage by stage)
+STAGE_LOOP_MIN_N = 6
+STAGE_LOOP_MIN_STAGES = 3
 #: the ensemble kernel checks the block at least this often (steps) and keeps a copy of it
 CHECKPOINT = 32
 _NONFINITE = int(Status.NONFINITE_STATE)
@@ -171,14 +195,21 @@ BUFFERS = {
     "xs": ("stack1(N2)", "a stage's state (block_norms: the slot's state)"),
     "ks": ("stack1(N2)", "the stage's right-hand side"),
     "gj": ("stack1(ng)", "block_norms: the slot's residual"),
+    "xk": ("stack1(N2)", "member_loop_step: the slot's state before the step"),
+    "xn": ("stack1(N2)", "... after it"),
+    "gv": ("stack1(ng)", "... the residual its first stage evaluated"),
 }
 
 
 def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     """The block-lockstep ensemble kernel of ``model`` (memoized per law kind, the scheme's
-    number of stages, block, the shape of the law's matrix and whether the decay
+    number of stages (stepped stage by stage, see ``STAGE_LOOP_MIN_N``) or the kinds of
+    its coefficients (written out), block, the shape of the law's matrix and whether the decay
     measurement pools the constraints, :func:`pooled_constraints`)."""
-    spec = Spec("block", law=bound.code, law_fn=bound.fn, stages=(len(scheme.b),),
+    by_stage = model.n >= STAGE_LOOP_MIN_N and len(scheme.b) >= STAGE_LOOP_MIN_STAGES
+    spec = Spec("block", law=bound.code, law_fn=bound.fn,
+                pattern=() if by_stage else tableau_pattern(scheme),
+                stages=(len(scheme.b),) if by_stage else (),
                 block=block, n_params=len(model.param_names), law_shape=bound.matrix.shape,
                 pooled=pooled_constraints(model, bound.law))  # fmt: skip
     return memo(model, spec, lambda: build_block_kernel(kernels_for(model, bound), spec))
@@ -256,13 +287,14 @@ def build_block_kernel(K, spec: Spec):
     one-step map pooled over ``spec.pooled`` holonomic constraints (−1: the full map;
     :func:`.decay.map_width`), all fixed at compile time; the scheme's coefficients, the
     parameters and the law's numbers are run-time arrays (:mod:`.groups`)."""
-    block, n_params = spec.block, spec.n_params
+    block, n_params, pattern = spec.block, spec.n_params, spec.pattern
     law_shape, pooled = spec.law_shape, spec.pooled
     rhs, residual, energy = K.rhs, K.residual, K.energy
     K_make_workspace = K.make_workspace
     N2, ng = 2 * K.n, K.ng
     B = block
-    S_ = spec.stages[0]
+    by_stage = not pattern  # (the spec names the stages, or the coefficients' kinds)
+    S_ = spec.stages[0] if by_stage else len(pattern[1])
     SN2 = S_ * N2
     NB = N2 * B  # the entries of the block's state
     NP = max(n_params, 1)
@@ -352,6 +384,30 @@ def build_block_kernel(K, spec: Spec):
             Xf[i] = fma(tau, XSf[i], Xf[i])
         for j in range(B):
             code[j] |= cm[j]
+
+    member_step = None if by_stage else _member_step(rhs, N2, ng, pattern)
+
+    @njit(inline="always", error_model="numpy")
+    def member_loop_step(X, t, tau, p, lm, ls, ta, tb, tc, XS, KS, GS, cm, code, Dv):
+        """:func:`block_step` for a small model: one loop over the slots whose body is the
+        member's whole step, its stages written out (:func:`.rk.steps._member_step`);
+        ``XS``, ``KS``, ``GS`` and ``cm`` are not used."""
+        for j in range(B):
+            ws = stack_workspace()
+            xk = stack1(N2)
+            xs = stack1(N2)
+            xn = stack1(N2)
+            gv = stack1(ng)
+            for l in range(N2):
+                xk[l] = X[l, j]
+            c = member_step(t, xk, tau, p, lm, ls, ta, tb, tc, ws, xs, xn, gv)
+            for l in range(N2):
+                X[l, j] = xn[l]
+            code[j] |= c
+            for l in range(ng):
+                Dv[l, j] = gv[l]
+
+    step = block_step if by_stage else member_loop_step
 
     @njit(nogil=True, error_model="numpy")
     def block_kernel(inputs, grid, tableau, measure, out, b_lo, b_hi):
@@ -505,7 +561,7 @@ def build_block_kernel(K, spec: Spec):
                 if has_ref:
                     for l in range(ng):
                         gr[l] = g_ref[i - 1, l]
-                block_step(X, t, tau, p_s, lm, ls, ta, tb, tc, XS, KS, GS, cm, code, Dv)
+                step(X, t, tau, p_s, lm, ls, ta, tb, tc, XS, KS, GS, cm, code, Dv)
                 if has_out:  # g(x_{i-1}), evaluated by the step's first stage
                     for l in range(ng):
                         g_out[i - 1, l] = Dv[l, 0]
@@ -603,8 +659,8 @@ def build_block_kernel(K, spec: Spec):
                             rho_R)  # fmt: skip
 
     key = spec.key(K.key)
-    tag(key, block_norms, block_step, pairs_full,
+    tag(key, block_norms, step, *(() if by_stage else (member_step,)), pairs_full,
         *((bin_flush, end_flush) if FULL and pooled < 0 else ()))  # (closures only)
     kernel = keyed_cache(block_kernel, key)
-    kernel.block_step = block_step  # (compiled inside the kernel; a test compiles it apart)
+    kernel.block_step = step  # (compiled inside the kernel; a test compiles it apart)
     return kernel
