@@ -343,7 +343,7 @@ def build_block_kernel(K, spec: Spec):
         buffers as flat arrays: one loop each, which LLVM vectorizes without writing it
         out (over ``X[l, j]`` for each ``l``, it wrote out all ``N2 · B`` entries of each
         sum, more code than the right-hand side's)."""
-        S = tb.shape[0]  # (a run-time count: LLVM does not copy the stage loop per stage)
+        S = tb.shape[0]
         Xf = X.reshape(NB)
         XSf = XS.reshape(NB)
         KSf = KS.reshape(S_ * NB)
