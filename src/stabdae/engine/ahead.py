@@ -37,7 +37,8 @@ WAIT_S = 300.0
 #: the helper yields a shared CPU to this process, whose compiling is the one waited for
 _CHILD = (
     "import os\n"
-    "os.nice(10)\n"
+    "if hasattr(os, 'nice'):\n"
+    "    os.nice(10)\n"
     "import sys, stabdae\n"
     "model = stabdae.load_model(sys.argv[1], sys.argv[2])\n"
     "stabdae.sample_perturbations(model, 1, threads=1)\n"
