@@ -83,8 +83,8 @@ def test_a_helper_process_compiles_the_sampler_while_the_kernel_compiles(tmp_pat
     """A new model's first ensemble, with two CPUs and the kernel cache: a helper process
     compiles the sampler into the cache while the ensemble compiles its kernel, and the
     ensemble loads the sampler from there (one hit, no miss; the kernel one miss).  The
-    numbers are those of a process that compiled both itself.  Without the helper (it
-    switched off) both are compiled here."""
+    numbers are those of a process that compiled both itself, where the helper was
+    switched off."""
     from stabdae.engine.ahead import _usable_cpus
 
     if _usable_cpus() < 2:

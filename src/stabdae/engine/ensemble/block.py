@@ -7,9 +7,9 @@ the block takes one of two forms, the same operations in the same order:
 * for a scheme of ``STAGE_LOOP_MIN_STAGES`` stages or more on a model of
   ``STAGE_LOOP_MIN_N`` coordinates or more, stage by stage (``block_step``): the stage's
   argument for every member (one loop over the block's entries), then one loop over the
-  members whose body is a call of the stabilized
-  right-hand side (:mod:`stabdae.engine.rhs`, the user's functions inside) on buffers
-  that live on the stack (:func:`stack1`, :func:`stack2`), then the weighted sum.  The
+  members whose body is a call of the stabilized right-hand side
+  (:mod:`stabdae.engine.rhs`, the user's functions inside) on buffers that live on the
+  stack (:func:`stack1`, :func:`stack2`), then the weighted sum.  The
   right-hand side is inlined once, whatever the number of stages: written out per stage,
   each stage added the right-hand side's compile time again (the Whipple bicycle's
   kernel: 9.3 s with Euler, 13.1 s with the midpoint rule, 19.6 s with RK4; stage by
@@ -281,11 +281,12 @@ def block_failed(X, code):
 
 def build_block_kernel(K, spec: Spec):
     """The block-lockstep ensemble kernel for the kernels ``K`` and the compile spec
-    ``spec``: an explicit scheme of ``spec.stages[0]`` stages, blocks of ``spec.block``
-    members, ``spec.n_params``
-    parameters, a law matrix of shape ``spec.law_shape`` and the decay measurement's
-    one-step map pooled over ``spec.pooled`` holonomic constraints (−1: the full map;
-    :func:`.decay.map_width`), all fixed at compile time; the scheme's coefficients, the
+    ``spec``: an explicit scheme of ``spec.stages[0]`` stages stepped stage by stage, or
+    one whose coefficients are of the kinds ``spec.pattern`` (:func:`tableau_pattern`)
+    with each member's stages written out; blocks of ``spec.block`` members,
+    ``spec.n_params`` parameters, a law matrix of shape ``spec.law_shape`` and the decay
+    measurement's one-step map pooled over ``spec.pooled`` holonomic constraints (−1: the
+    full map; :func:`.decay.map_width`), all fixed at compile time; the scheme's coefficients, the
     parameters and the law's numbers are run-time arrays (:mod:`.groups`)."""
     block, n_params, pattern = spec.block, spec.n_params, spec.pattern
     law_shape, pooled = spec.law_shape, spec.pooled
@@ -389,7 +390,8 @@ def build_block_kernel(K, spec: Spec):
 
     @njit(inline="always", error_model="numpy")
     def member_loop_step(X, t, tau, p, lm, ls, ta, tb, tc, XS, KS, GS, cm, code, Dv):
-        """:func:`block_step` for a small model: one loop over the slots whose body is the
+        """:func:`block_step`'s other form (below ``STAGE_LOOP_MIN_N`` coordinates or
+        ``STAGE_LOOP_MIN_STAGES`` stages): one loop over the slots whose body is the
         member's whole step, its stages written out (:func:`.rk.steps._member_step`);
         ``XS``, ``KS``, ``GS`` and ``cm`` are not used."""
         for j in range(B):
