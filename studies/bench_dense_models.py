@@ -25,7 +25,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 
-#: (scene, scheme, ω, τ, t_end, members): Baumgarte ξ = 1, radii 1e-8 … 1e-4
+#: (scene, scheme, ω, τ, t_end, members): Baumgarte ξ = 1 (k = 10 for nonholonomic
+#: rows), radii 1e-8 … 1e-4
 CONFIGS = [
     ("andrews", "midpoint", 1e3, 1e-5, 0.006, 2000),
     ("andrews", "rk4", 1e3, 1e-5, 0.006, 2000),
@@ -35,6 +36,10 @@ CONFIGS = [
     ("double_pendulum", "dop853", 10.0, 0.02, 2.0, 10000),
     ("spherical_pendulum", "rk4", 10.0, 1e-3, 2.0, 4000),
     ("pendulum", "dop853", 10.0, 0.02, 10.0, 10000),  # diagonal mass: the width alone
+    # coupled mechanisms of many constraints (k = 10 for the bicycle's rolling rows)
+    ("n_four_bar", "rk4", 10.0, 1e-3, 1.0, 4096),
+    ("bricard_independent", "midpoint", 10.0, 1e-3, 1.0, 4096),
+    ("bicycle_redundant", "midpoint", 10.0, 1e-3, 1.0, 4096),
 ]
 
 _CHILD = """
@@ -43,7 +48,7 @@ import numpy as np
 import stabdae
 scene, scheme, omega, tau, t_end, members, repeat, kernels = sys.argv[1:]
 model = stabdae.load_model(f"{kernels}/{scene}.py")
-law = stabdae.baumgarte(float(omega), 1.0)
+law = stabdae.baumgarte(float(omega), 1.0, 10.0 if model.k else None)
 kw = dict(members=int(members), radius=(1e-8, 1e-4), seed=1, traces="none", states=True)
 start = time.perf_counter()
 stabdae.ensemble(model, law, scheme, float(tau), float(t_end), **kw)

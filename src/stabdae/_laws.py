@@ -75,7 +75,7 @@ class Law:
     def bind(self, model: Model) -> BoundLaw:
         A = np.ascontiguousarray(self.A(model))
         factors = _scalar_blocks(A, model.m, model.k)
-        if factors is not None and model.sparse_structure() is not None:
+        if factors is not None:
             return BoundLaw(self, int(LawKind.SCALAR_BLOCKS), factors, np.zeros(1))
         return BoundLaw(self, int(LawKind.CONSTANT), A, np.zeros(1))
 

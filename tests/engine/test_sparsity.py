@@ -9,14 +9,18 @@ from numba import njit
 
 import stabdae
 from conftest import KERNELS, SCENES, load_scene, perturbed_state, scene_module
-from stabdae._laws import bind_law
+from stabdae._laws import BoundLaw, bind_law
 from stabdae.engine.rhs import LAW_CONSTANT, LAW_SCALAR_BLOCKS, kernels_for
 from stabdae.engine.sparsity import dense_cost, fill_pattern, sparse_cost, structure
 
 
-def _rhs_and_projection(model, law, x, t=0.05):
-    """ẋ at ``x`` and ``x`` after one full projection, through the compiled pieces."""
+def _rhs_and_projection(model, law, x, t=0.05, full=False):
+    """ẋ at ``x`` and ``x`` after one full projection, through the compiled pieces;
+    ``full``: the constant law applied as its full matrix ``A`` (the sums with their zero
+    terms), whatever form it binds to."""
     bound = bind_law(law, model)
+    if full:
+        bound = BoundLaw(law, LAW_CONSTANT, np.ascontiguousarray(law.A(model)), np.zeros(1))
     K = kernels_for(model, bound)
     # parameters away from their defaults (unit masses would hide a forgotten M⁻¹)
     p = model.param_vector() * np.linspace(1.1, 1.5, len(model.params))
@@ -43,13 +47,13 @@ def test_sparse_and_dense_paths_agree_on_every_scene(name):
     dense = model if model.sparse_structure() is None else model.replace(sparsity="dense")
     assert dense.sparse_structure() is None
     law = stabdae.baumgarte(omega=6.0, xi=0.8, k=4.0)
-    # Baumgarte's blocks are multiples of the identity: the sparse path applies A by its
-    # three factors, the dense one by the full matrix
-    assert bind_law(law, sparse).code == LAW_SCALAR_BLOCKS
-    assert bind_law(law, dense).code == LAW_CONSTANT
+    # Baumgarte's blocks are multiples of the identity: both paths apply A by its three
+    # factors; here the dense one applies it as the full matrix
+    assert bind_law(law, sparse).code == bind_law(law, dense).code == LAW_SCALAR_BLOCKS
     for seed in range(3):
         x = perturbed_state(model, 1e-2, seed)
-        (a, pa), (b, pb) = _rhs_and_projection(sparse, law, x), _rhs_and_projection(dense, law, x)
+        (a, pa), (b, pb) = (_rhs_and_projection(sparse, law, x),
+                            _rhs_and_projection(dense, law, x, full=True))  # fmt: skip
         assert a[0] == b[0] == 0 and pa[0] == pb[0]
         np.testing.assert_array_equal(a[1], b[1])
         np.testing.assert_array_equal(pa[1], pb[1])
@@ -58,9 +62,10 @@ def test_sparse_and_dense_paths_agree_on_every_scene(name):
 @pytest.mark.parametrize("name", SCENES)
 def test_written_out_structure_and_dense_loops_agree_on_every_scene(name):
     """Where the sparse path does not apply (a mass matrix that is not diagonal, or too
-    little to save), the dense path's linear algebra is written out without the model's
-    structural zeros: the same numbers as the dense loops up to the sign of a zero, at
-    states off the manifold."""
+    little to save), the dense path's linear algebra and its products ``f_q v``, ``h_q v``
+    are written out without the model's structural zeros, and the law is applied by its
+    three factors: the same numbers as the dense loops with the law's full matrix up to
+    the sign of a zero, at states off the manifold."""
     from stabdae.engine.rhs import _structured
 
     model = load_scene(name)
@@ -78,8 +83,8 @@ def test_written_out_structure_and_dense_loops_agree_on_every_scene(name):
     for law in (stabdae.baumgarte(omega=6.0, xi=0.8, k=4.0), stabdae.none()):
         for seed in range(3):
             x = perturbed_state(model, 1e-2, seed)
-            (a, _), (b, _) = _rhs_and_projection(model, law, x), _rhs_and_projection(dense,
-                                                                                       law, x)
+            (a, _), (b, _) = (_rhs_and_projection(model, law, x),
+                              _rhs_and_projection(dense, law, x, full=True))  # fmt: skip
             assert a[0] == b[0] == 0
             np.testing.assert_array_equal(a[1], b[1])
 

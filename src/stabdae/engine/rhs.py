@@ -71,7 +71,8 @@ LAW_USER = int(LawKind.USER)
 LAW_ACPR = int(LawKind.ACPR)  # A = 0 plus the correction −γ_s D (G D)⁻¹ g
 #: a constant A whose blocks are multiples of the identity (Baumgarte's), given by its three
 #: factors (f, ḟ, h) as a 1 × 3 matrix: the same sums as LAW_CONSTANT without their zero
-#: terms (bound so only for the sparse path, where r × (2m + k) products would dominate)
+#: terms (2m + k products instead of r × (2m + k), in loops short enough for LLVM to
+#: unroll inside the ensemble kernel's vectorized member loop)
 LAW_SCALAR_BLOCKS = int(LawKind.SCALAR_BLOCKS)
 
 # Relative pivot thresholds of the L D Lᵀ factorizations: a pivot below RTOL·max|diag|
@@ -205,7 +206,8 @@ class Pieces(NamedTuple):
     """The compiled pieces of a model that no law touches (:func:`_pieces`): its sizes and
     which functions it has, its functions with the library's flags, ``residual``,
     ``project``, ``energy``, the workspace builders, the sparse path's helpers and index
-    lists (unused, and typed placeholders, on the dense path), and ``key``, the on-disk
+    lists (unused, and typed placeholders, on the dense path), the dense path's ``h_q v``
+    written out (:func:`_velocity_products`), and ``key``, the on-disk
     key of the model's part (None: a function without a source file)."""
 
     n: int
@@ -227,6 +229,7 @@ class Pieces(NamedTuple):
     stack_workspace: object
     sparse_Y: object
     sparse_S: object
+    hq_v: object
     FPTR: np.ndarray
     FCOL: np.ndarray
     CPTR: np.ndarray
@@ -285,6 +288,9 @@ def _pieces(model, sparse: bool) -> Pieces:
     make_workspace, stack_workspace = builders(n, m, k)
     st = model.sparse_structure() if sparse else None
     SPARSE = st is not None
+    # the dense path's products by F's velocity columns written out over the patterns' non-zeros
+    fq_v, hq_v = (_noop4, _noop4) if SPARSE else _velocity_products(model, HAS_FT, HAS_HT)
+    FQ_V, HQ_V = fq_v is not _noop4, hq_v is not _noop4
     if SPARSE:
         FPTR, FCOL, CPTR, CROW = st.fptr, st.fcol, st.cptr, st.crow
         HQPTR, HQCOL = st.hqptr, st.hqcol
@@ -344,7 +350,9 @@ def _pieces(model, sparse: bool) -> Pieces:
             f_q(t, q, p, fq)
             if HAS_FT:
                 f_t(t, q, p, sm)
-            for i in range(m):
+            if FQ_V:
+                fq_v(fq, v, sm, g)
+            for i in range(0 if FQ_V else m):
                 s = sm[i] if HAS_FT else -0.0
                 if SPARSE:
                     for e in range(FPTR[i], FPTR[i + 1]):
@@ -434,15 +442,47 @@ def _pieces(model, sparse: bool) -> Pieces:
         return energy_fn(t, q, v, p)
 
     model_key = fingerprint(
-        n, m, k, model.structure_key() if SPARSE else "dense",
+        n, m, k, model.structure_key() if SPARSE or FQ_V or HQ_V else "dense",
         tuple((piece, optional_fingerprint(fn)) for piece, fn in sorted(fns.items())),
         optional_fingerprint(model.energy),
     )  # fmt: skip
     key = Spec("pieces", sparse=sparse).key(model_key)
     tag(key, residual, energy, project, make_workspace, stack_workspace)
     return Pieces(n, m, k, r, ng, HAS_MASS, HAS_HT, SPARSE, mass, forces, f_accel, h_t, residual,
-                  project, energy, make_workspace, stack_workspace, sparse_Y, sparse_S, FPTR,
-                  FCOL, CPTR, CROW, HQPTR, HQCOL, LPTR, LCOL, LTPTR, LROW, key)  # fmt: skip
+                  project, energy, make_workspace, stack_workspace, sparse_Y, sparse_S, hq_v,
+                  FPTR, FCOL, CPTR, CROW, HQPTR, HQCOL, LPTR, LCOL, LTPTR, LROW, key)  # fmt: skip
+
+
+def _velocity_products(model, has_ft: bool, has_ht: bool):
+    """The dense path's ``ḟ = f_q v + f_t`` (into ``g[m:2m]``) and ``−h_q v − h_t`` (into
+    ``rl[m:]``) written out over the non-zeros of ``f_q``'s and ``h_q``'s patterns, in the
+    loops' order (the same sums without their structurally zero terms, as on the sparse
+    path); :func:`_noop4` for a piece without patterns, or with more than
+    ``UNROLL_MAX_OPS`` non-zeros.
+
+    Written out, not looped: a loop over the rows that LLVM does not unroll (Bricard's
+    14 × 15 ``f_q``) stays inside the ensemble kernel's loop over the members, which is
+    then no longer innermost and runs one member at a time."""
+    pats, n, m, k = model.patterns, model.n, model.m, model.k
+    tag_ = model.structure_key()[:8] if pats is not None else ""
+    out = []
+    for rows, piece, has_t, header, start, term, dst in (
+        (m, "f_q", has_ft, "def fq_v(fq, v, sm, g):", "sm[{i}]",
+         "s = fma(fq[{i}, {j}], v[{j}], s)", "g[{r}] = s"),
+        (k, "h_q", has_ht, "def hq_v(hq, v, sk, rl):", "-sk[{i}]",
+         "s = fnma(hq[{i}, {j}], v[{j}], s)", "rl[{r}] = s"),
+    ):  # fmt: skip
+        pat = None if pats is None or not rows else pats.get(piece)
+        if pat is None or int(pat.sum()) > UNROLL_MAX_OPS:
+            out.append(_noop4)
+            continue
+        lines = []
+        for i in range(rows):
+            lines.append("s = " + (start.format(i=i) if has_t else "-0.0"))
+            lines += [term.format(i=i, j=j) for j in range(n) if pat[i, j]]
+            lines.append(dst.format(r=m + i))
+        out.append(_inline(_written_out(header, lines, f"{piece}_v_{tag_}")))
+    return tuple(out)
 
 
 def _nested(a) -> tuple:
@@ -535,6 +575,8 @@ def _build(model, spec: Spec) -> Kernels:
     residual, project, energy = P.residual, P.project, P.energy
     make_workspace, stack_workspace = P.make_workspace, P.stack_workspace
     sparse_Y, sparse_S = P.sparse_Y, P.sparse_S
+    hq_v = P.hq_v
+    HQ_V = hq_v is not _noop4
     FPTR, FCOL, CPTR, CROW, HQPTR, HQCOL = P.FPTR, P.FCOL, P.CPTR, P.CROW, P.HQPTR, P.HQCOL
     LPTR, LCOL, LTPTR, LROW = P.LPTR, P.LCOL, P.LTPTR, P.LROW
     LAW = law_code
@@ -586,7 +628,9 @@ def _build(model, spec: Spec) -> Kernels:
         if k > 0:
             if HAS_HT:
                 h_t(t, q, v, p, sk)
-            for i in range(k):
+            if HQ_V:
+                hq_v(hq, v, sk, rl)
+            for i in range(0 if HQ_V else k):
                 s = -sk[i] if HAS_HT else -0.0
                 if SPARSE:
                     for e in range(HQPTR[i], HQPTR[i + 1]):
