@@ -227,7 +227,7 @@ def test_written_out_code_reads_and_writes_each_entry_once():
     for fn in (linalg.ldl_factor_for(n), linalg.ldl_solve_for(n),
                linalg.ldl_solve_columns_for(n, 3)):  # fmt: skip
         line = getattr(fn, "straight_line", None)  # the code it compiles, where the JIT runs
-        source = linalg._unparsed(line) if line is not None else inspect.getsource(fn)
+        source = linalg._unparsed(line()) if line is not None else inspect.getsource(fn)
         reads = re.findall(r"_at\d\((\w+), ([\d, ]+)\)", source)
         writes = re.findall(r"_set\d\((\w+), ([\d, ]+), ", source)
         assert reads and writes

@@ -516,18 +516,32 @@ class _Lowering(_Walk):
         self.store(target, self.expr(value))
 
 
-def emitted(fn_def: ast.FunctionDef, namespace: dict, label: str, fused: bool = HOST_FMA):
+def emitted(fn_def, namespace: dict, label: str, fused: bool = HOST_FMA, params=None):
     """An intrinsic named ``label`` doing what the straight-line function ``fn_def`` does
     with the globals ``namespace`` (see the module docstring for the language); raises
     NotImplementedError for code outside that language.  ``fused``: whether the written-out
     linear algebra's ``fma`` is the fused multiply-add (else ``a * b + c``, as
-    :func:`.fma.fma` on a CPU without one)."""
-    fn = _Function(fn_def, namespace, fused)
+    :func:`.fma.fma` on a CPU without one).
+
+    ``fn_def`` may instead be a function that returns it, with ``params`` its arguments'
+    names: it is then called, and the code checked, when numba first types the intrinsic,
+    which a kernel loaded from the cache never does (for code the library writes itself,
+    which is in the language by construction; its checks then fail at compile time)."""
+    if params is None:
+        checked = _Function(fn_def, namespace, fused)
+        params = checked.params
+        build = lambda: checked  # noqa: E731
+    else:
+        build = lambda: _Function(fn_def(), namespace, fused)  # noqa: E731
+    made: list = []
     typings: dict = {}  # argument types -> _Typing
 
     def typer(typingctx, *argtypes):
-        if len(argtypes) != len(fn.params):
+        if len(argtypes) != len(params):
             return None
+        if not made:
+            made.append(build())
+        fn = made[0]
         if argtypes not in typings:
             typings[argtypes] = _Typing(fn, typingctx, argtypes)
         typing = typings[argtypes]
@@ -544,7 +558,7 @@ def emitted(fn_def: ast.FunctionDef, namespace: dict, label: str, fused: bool = 
 
     # numba reads the typer's parameters for the intrinsic's (a ``*args`` typer would be
     # called with one tuple): one explicit parameter per argument
-    names = ", ".join(fn.params)
+    names = ", ".join(params)
     spelled = {"_typer": typer}
     exec(f"def {label}(typingctx, {names}):\n    return _typer(typingctx, {names})\n", spelled)
     return intrinsic(spelled[label])

@@ -347,17 +347,22 @@ def _written_out(header: str, lines: list[str], label: str):
     """The straight-line function ``header`` + ``lines``, its entries held in locals
     (:func:`_scalarized`), compiled: lowered by :func:`.emit.emitted` (no numba typing of
     its statements) behind a one-line function that numba inlines where it is called
-    (callable from Python), whose ``emitted`` attribute is the intrinsic itself."""
-    fn_def = _scalarized_tree(header + "\n" + "".join(f"    {line}\n"
-                                                      for line in lines or ["pass"]))
+    (callable from Python), whose ``emitted`` attribute is the intrinsic itself.
+
+    The code is parsed, rewritten and checked only when a compilation first reads it
+    (``straight_line()``): a process whose kernels come from the cache skips that (a
+    second of Python on a 12-coordinate bicycle's written-out linear algebra)."""
+    source = header + "\n" + "".join(f"    {line}\n" for line in lines or ["pass"])
+    fn_def = cache(lambda: _scalarized_tree(source))
     name, params = header[4:header.index("(")], header[header.index("(") + 1:header.index(")")]
     if not JIT:
-        return exec_source(_unparsed(fn_def), label, {"fma": fma, "fnma": _fnma, **_PY_ENTRY})[name]
+        return exec_source(_unparsed(fn_def()), label,
+                           {"fma": fma, "fnma": _fnma, **_PY_ENTRY})[name]  # fmt: skip
     wrapper = f"def {name}({params}):\n    return _emitted({params})\n"
-    emitted_ = emitted(fn_def, {}, label)
+    emitted_ = emitted(fn_def, {}, label, params=[a.strip() for a in params.split(",")])
     call = exec_source(wrapper, label + "_call", {"_emitted": emitted_})[name]
     out = njit(error_model="numpy", forceinline=True)(call)
-    out.straight_line = fn_def  # the code it does (:func:`_unparsed` reads it)
+    out.straight_line = fn_def  # the code it does, on demand (:func:`_unparsed` reads it)
     out.emitted = emitted_  # for compiled callers: no function of its own to compile
     return out
 
