@@ -71,8 +71,12 @@ def matched(got: np.ndarray, want: np.ndarray) -> float:
 def test_linearisation_has_the_benchmarks_eigenvalues(name):
     """At 0.5, 2, 5 (the weave stable, capsize stable) and 8 m/s (capsize unstable): the
     four eigenvalues away from zero are the published ones to 1e-10 relative (measured:
-    3.3e-12 or better, the published matrices having 14 digits), and the rest are zero to
-    1e-4 (measured 4e-5: zeros in Jordan blocks, which the differences spread)."""
+    4.0e-12 or better, the published matrices having 14 digits), and the rest are zero to
+    1e-4.  The zeros lie in Jordan blocks, which spread an error δ of the differences to
+    about √δ: with steps of 1e-6 (the accurate ones for the modes) the roundoff spread them
+    to 3.5e-5 (`bicycle`) and 1.05e-4 (`bicycle_redundant`) on an AMD EPYC (4e-5 on the
+    machine this test was written on); they are checked with steps of 1e-5 (measured
+    5.9e-6 and 8.0e-6 on the EPYC), whose modes are off by 3e-10."""
     model = load_scene(name)
     assert model.check().ok
     for speed in (0.5, 2.0, 5.0, 8.0):
@@ -81,7 +85,9 @@ def test_linearisation_has_the_benchmarks_eigenvalues(name):
         want = published_eigenvalues(speed)
         assert away.sum() == 4, (speed, lam[away])
         assert matched(lam[away], want) <= 1e-10, (speed, lam[away], want)
-        assert np.max(np.abs(lam[~away])) <= 1e-4
+        lam = linearised_eigenvalues(model, speed, step=1e-5)
+        away = np.abs(lam) > 1e-3
+        assert away.sum() == 4 and np.max(np.abs(lam[~away])) <= 1e-4, (speed, lam)
 
 
 def test_self_stable_speeds_follow_the_benchmark():
