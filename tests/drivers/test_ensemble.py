@@ -183,6 +183,31 @@ def step_form(request, monkeypatch):
     return request.param
 
 
+def test_two_stage_schemes_step_stage_by_stage_where_the_right_hand_side_is_large():
+    """A two-stage scheme steps the block stage by stage where the right-hand side's
+    straight-line code is large (the bicycle's: its midpoint kernel compiles in a fraction
+    of the time, and integrates as fast), and with its stages written out where it is
+    small (the N-four-bar's, which integrates 21 % faster so); three or more stages go
+    stage by stage on both, one stage on neither.  No kernel is compiled here."""
+    from stabdae._laws import bind_law
+    from stabdae._schemes import as_scheme
+    from stabdae.engine.ensemble import block
+    from stabdae.engine.rhs import kernels_for
+
+    law = stabdae.baumgarte(10.0, 1.0, 10.0)
+    forms = {}
+    for name in ("bicycle", "n_four_bar"):
+        model = load_scene(name)
+        bound = bind_law(law, model)
+        assert model.n >= block.STAGE_LOOP_MIN_N
+        forms[name] = (kernels_for(model, bound).size,
+                       [block.ensemble_kernel_for(model, bound, as_scheme(s)).block_step.__name__
+                        for s in ("euler", "midpoint", "rk4")])  # fmt: skip
+    assert forms["bicycle"][0] >= block.STAGE_LOOP_MIN_SIZE > forms["n_four_bar"][0] > 0
+    assert forms["bicycle"][1] == ["member_loop_step", "block_step", "block_step"]
+    assert forms["n_four_bar"][1] == ["member_loop_step", "member_loop_step", "block_step"]
+
+
 @pytest.mark.parametrize("spec", ["euler", "midpoint", "rk4", "dop853", (0.3, 0.0), (0.25, 2.0)])
 def test_block_step_and_looped_step_agree_for_every_tableau_pattern(spec, step_form):
     """The ensemble kernel's step, with each member's stages written out for the pattern

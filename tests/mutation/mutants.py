@@ -763,4 +763,17 @@ MUTANTS = [
            '            pick = b.fcmp_ordered(">" if callee is max else "<", x, y)',
            ('tests/engine/test_emit.py',),
            "max and min of two floats pick the other operand (NaN, ±0)"),
+    # ---- the dense path's written-out products and the block step's form by size
+    Mutant("velocity-product-row",
+           E + "rhs.py",
+           "            lines.append(dst.format(r=m + i))",
+           "            lines.append(dst.format(r=i))",
+           ('tests/engine/test_sparsity.py::test_written_out_structure_and_dense_loops_agree_on_every_scene',),
+           "the written-out f_q v lands on f's rows of g instead of ḟ's"),
+    Mutant("stage-loop-ignores-size",
+           E + "ensemble/block.py",
+           "        stages == 2 and K.size >= STAGE_LOOP_MIN_SIZE))  # fmt: skip",
+           "        stages == 2))  # fmt: skip",
+           ('tests/drivers/test_ensemble.py::test_two_stage_schemes_step_stage_by_stage_where_the_right_hand_side_is_large',),
+           "every two-stage scheme on a model of six coordinates steps stage by stage"),
 ]

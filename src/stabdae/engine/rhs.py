@@ -32,7 +32,10 @@ addition per sum).
 
 from __future__ import annotations
 
+import ast
+import inspect
 import math
+import textwrap
 from collections import namedtuple
 from typing import NamedTuple
 
@@ -147,10 +150,11 @@ def _diagonal_inverse(Mw, n):
 _NO_INDEX = np.zeros(1, dtype=np.int64)
 
 Kernels = namedtuple(
-    "Kernels", "rhs residual energy project make_workspace stack_workspace n m k ng key"
+    "Kernels", "rhs residual energy project make_workspace stack_workspace n m k ng key size"
 )
 Kernels.__doc__ = """The compiled pieces of one (model, law kind); ``key`` identifies what they
-were compiled from (:mod:`.cache`), ``None`` when a function has no source file."""
+were compiled from (:mod:`.cache`), ``None`` when a function has no source file; ``size``
+the right-hand side's straight-line code (:func:`rhs_size`)."""
 
 #: projection after each step: name -> (sweeps per level, tolerance); see ``project``
 PROJECTIONS = {None: (0, 0.0), "post": (1, 0.0), "full": (8, 0.0)}
@@ -243,9 +247,26 @@ class Pieces(NamedTuple):
     key: str | None
 
 
+def _statements(fn) -> int:
+    """The statements of ``fn``'s source (0 without a source)."""
+    try:
+        source = textwrap.dedent(inspect.getsource(python_function(fn)))
+    except (OSError, TypeError):
+        return 0
+    return sum(isinstance(node, ast.stmt) for node in ast.walk(ast.parse(source))) - 1
+
+
+def rhs_size(model, plan) -> int:
+    """How much straight-line code the right-hand side inlines: the statements of the
+    model's functions (a generated model's: about one operation each) and the
+    multiply-adds of its written-out linear algebra (``plan``, or None).  The ensemble
+    kernel steps the block stage by stage above a size (:mod:`.ensemble.block`)."""
+    return sum(_statements(fn) for fn in model.functions.values()) + (plan.ops if plan else 0)
+
+
 class Plan(NamedTuple):
     """The dense path's linear algebra written out for a model's structural zeros
-    (:func:`_structured`)."""
+    (:func:`_structured`); ``ops`` its multiply-adds and loads, all pieces together."""
 
     factor_M: object
     solve_M: object
@@ -256,6 +277,7 @@ class Plan(NamedTuple):
     gram: object
     add_Fz: object
     accel: object
+    ops: int
 
 
 def _pieces(model, sparse: bool) -> Pieces:
@@ -523,7 +545,8 @@ def _structured(model, n: int, m: int, k: int) -> Plan | None:
     ops = (m_ops, y_ops, gram_ops, s_ops)
     dense = (n**3 // 6 if has_mass else 0, n * n * r if has_mass else 0,
              n * r * (r + 1) // 2, r**3 // 6)  # fmt: skip
-    if max(ops) > UNROLL_MAX_OPS or sum(ops) + F.sum() + Ypat.sum() >= sum(dense) + 2 * n * r:
+    total = int(sum(ops) + F.sum() + Ypat.sum())
+    if max(ops) > UNROLL_MAX_OPS or total >= sum(dense) + 2 * n * r:
         return None
 
     def entry(i, j):
@@ -559,6 +582,7 @@ def _structured(model, n: int, m: int, k: int) -> Plan | None:
         gram=_written_out("def gram(fq, hv, Y, S):", gram, f"gram_{tag_}"),
         add_Fz=_written_out("def add_Fz(fq, hv, z, rl):", add_fz, f"add_Fz_{tag_}"),
         accel=_written_out("def accel(Y, z, rl, v, xdot):", accel, f"accel_{tag_}"),
+        ops=total,
     )
 
 
@@ -777,4 +801,4 @@ def _build(model, spec: Spec) -> Kernels:
     key = spec.key(P.key, *flags)
     tag(key, rhs)
     return Kernels(rhs, residual, energy, project, make_workspace, stack_workspace, n, m, k,
-                   ng, key)
+                   ng, key, rhs_size(model, plan))

@@ -5,7 +5,8 @@ holds a block of ``BLOCK`` members as arrays ``X[state, member]`` on the stack. 
 the block takes one of two forms, the same operations in the same order:
 
 * for a scheme of ``STAGE_LOOP_MIN_STAGES`` stages or more on a model of
-  ``STAGE_LOOP_MIN_N`` coordinates or more, stage by stage (``block_step``): the stage's
+  ``STAGE_LOOP_MIN_N`` coordinates or more (of two stages, where the right-hand side's
+  code is also ``STAGE_LOOP_MIN_SIZE`` or more), stage by stage (``block_step``): the stage's
   argument for every member (one loop over the block's entries), then one loop over the
   members whose body is a call of the stabilized right-hand side
   (:mod:`stabdae.engine.rhs`, the user's functions inside) on buffers that live on the
@@ -20,8 +21,8 @@ the block takes one of two forms, the same operations in the same order:
   written out for the scheme's pattern of zero / one / other coefficients
   (:func:`stabdae.engine.rk.steps.tableau_pattern`), zero terms left out, factors one
   dropped.  The stages stay in registers: stage by stage, through the block's buffers
-  in memory, the pendulum's midpoint ensemble integrated 36 % slower and the
-  12-coordinate bicycle's 12 %; a small right-hand side compiles quickly once per stage.
+  in memory, the pendulum's midpoint ensemble integrated 36 % slower and the rolling
+  disk's 31 %; a small right-hand side compiles quickly once per stage.
 
 The scheme's coefficients are run-time arrays in both.
 
@@ -105,15 +106,20 @@ from ..workspace import copy_inputs, copy_tableau, stack1, stack2, stack_int1
 BLOCK = 64
 #: schemes of at least ``STAGE_LOOP_MIN_STAGES`` stages on models of at least
 #: ``STAGE_LOOP_MIN_N`` coordinates step the block stage by stage (``block_step``: the
-#: right-hand side inlined once, whatever the stages); the others step each member through
-#: its stages written out (``member_loop_step``), whose copies of the right-hand side keep
-#: the stages in registers.  Stage by stage, integrating took 36 % longer for the
-#: pendulum's midpoint ensemble, 80 % for the double pendulum's (its RK4 23 %), 12 % for
-#: the 12-coordinate bicycle's midpoint, 1–5 % for the bicycle's and n_four_bar's RK4;
-#: written out, each stage beyond the first adds the right-hand side's compile time again
-#: (the bicycle's RK4 kernel: 19.6 s against 10.9 s stage by stage)
+#: right-hand side inlined once, whatever the stages), and so do two-stage schemes where
+#: the right-hand side's straight-line code (:func:`stabdae.engine.rhs.rhs_size`) is at
+#: least ``STAGE_LOOP_MIN_SIZE``; the others step each member through its stages written
+#: out (``member_loop_step``), whose copies of the right-hand side keep the stages in
+#: registers.  Stage by stage, integrating took 36 % longer for the pendulum's midpoint
+#: ensemble, 80 % for the double pendulum's (its RK4 23 %), 1–5 % for the bicycle's and
+#: n_four_bar's RK4; with the midpoint rule 31 % for the rolling disk (size 135), 21 % for
+#: n_four_bar (726), 2 % less for the bicycle (1959), 6 % less for Bricard (2661), 9 % less
+#: for the 12-coordinate bicycle (3353).  Written out, each stage beyond the first adds
+#: the right-hand side's compile time again (the bicycle's RK4 kernel: 19.6 s against
+#: 10.9 s stage by stage)
 STAGE_LOOP_MIN_N = 6
 STAGE_LOOP_MIN_STAGES = 3
+STAGE_LOOP_MIN_SIZE = 1000
 #: the ensemble kernel checks the block at least this often (steps) and keeps a copy of it
 CHECKPOINT = 32
 _NONFINITE = int(Status.NONFINITE_STATE)
@@ -206,13 +212,16 @@ def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
     number of stages (stepped stage by stage, see ``STAGE_LOOP_MIN_N``) or the kinds of
     its coefficients (written out), block, the shape of the law's matrix and whether the decay
     measurement pools the constraints, :func:`pooled_constraints`)."""
-    by_stage = model.n >= STAGE_LOOP_MIN_N and len(scheme.b) >= STAGE_LOOP_MIN_STAGES
+    K = kernels_for(model, bound)
+    stages = len(scheme.b)
+    by_stage = model.n >= STAGE_LOOP_MIN_N and (stages >= STAGE_LOOP_MIN_STAGES or (
+        stages == 2 and K.size >= STAGE_LOOP_MIN_SIZE))  # fmt: skip
     spec = Spec("block", law=bound.code, law_fn=bound.fn,
                 pattern=() if by_stage else tableau_pattern(scheme),
                 stages=(len(scheme.b),) if by_stage else (),
                 block=block, n_params=len(model.param_names), law_shape=bound.matrix.shape,
                 pooled=pooled_constraints(model, bound.law))  # fmt: skip
-    return memo(model, spec, lambda: build_block_kernel(kernels_for(model, bound), spec))
+    return memo(model, spec, lambda: build_block_kernel(K, spec))
 
 
 # The block's bookkeeping at checks and stops: sizes from the arrays, so that these are
