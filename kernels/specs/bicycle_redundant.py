@@ -1,4 +1,4 @@
-"""The Whipple bicycle of the benchmark by Meijaard, Papadopoulos, Ruina & Schwab, in 14
+"""The Whipple bicycle of the benchmark by Meijaard, Papadopoulos, Ruina & Schwab, in 12
 redundant coordinates, generated: the same bicycle as `bicycle`, with the two wheels'
 centres as coordinates of their own.
 
