@@ -266,7 +266,8 @@ def rhs_size(model, plan) -> int:
 
 class Plan(NamedTuple):
     """The dense path's linear algebra written out for a model's structural zeros
-    (:func:`_structured`); ``ops`` its multiply-adds and loads, all pieces together."""
+    (:func:`_structured`); ``ops`` its operations (multiply-adds and copies), all pieces
+    together."""
 
     factor_M: object
     solve_M: object

@@ -399,8 +399,9 @@ def build_block_kernel(K, spec: Spec):
 
     @njit(inline="always", error_model="numpy")
     def member_loop_step(X, t, tau, p, lm, ls, ta, tb, tc, XS, KS, GS, cm, code, Dv):
-        """:func:`block_step`'s other form (below ``STAGE_LOOP_MIN_N`` coordinates or
-        ``STAGE_LOOP_MIN_STAGES`` stages): one loop over the slots whose body is the
+        """:func:`block_step`'s other form (below ``STAGE_LOOP_MIN_N`` coordinates, one
+        stage, or two on a right-hand side smaller than ``STAGE_LOOP_MIN_SIZE``): one loop
+        over the slots whose body is the
         member's whole step, its stages written out (:func:`.rk.steps._member_step`);
         ``XS``, ``KS``, ``GS`` and ``cm`` are not used."""
         for j in range(B):
