@@ -74,9 +74,9 @@ def test_linearisation_has_the_benchmarks_eigenvalues(name):
     4.0e-12 or better, the published matrices having 14 digits), and the rest are zero to
     1e-4.  The zeros lie in Jordan blocks, which spread an error δ of the differences to
     about √δ: with steps of 1e-6 (the accurate ones for the modes) the roundoff spread them
-    to 3.5e-5 (`bicycle`) and 1.05e-4 (`bicycle_redundant`) on an AMD EPYC (4e-5 on the
-    machine this test was written on); they are checked with steps of 1e-5 (measured
-    5.9e-6 and 8.0e-6 on the EPYC), whose modes are off by 3e-10."""
+    to 3.5e-5 (`bicycle`) and 1.05e-4 (`bicycle_redundant`) in one environment of the
+    development machine (4e-5 in the one this test was written in); they are checked with
+    steps of 1e-5 (measured 5.9e-6 and 8.0e-6 there), whose modes are off by 3e-10."""
     model = load_scene(name)
     assert model.check().ok
     for speed in (0.5, 2.0, 5.0, 8.0):

@@ -82,8 +82,9 @@ SPECIAL = [0.0, -0.0, 1.0, -1.5, 1e-300, 3.0e300, np.inf, -np.inf, np.nan, 1.0 +
 def _bits(a) -> bytes:
     """``a``'s bytes with every NaN the same NaN.  Which of two NaN operands an x86
     addition returns (and so the result's sign) depends on their order, which LLVM may
-    commute, and does differently for different processors (on an AMD EPYC numba's code
-    and the emitted code returned NaNs of opposite signs for ``q`` below)."""
+    commute, and does differently from one build to another (numba's code and the emitted
+    code returned NaNs of opposite signs for ``q`` below in one environment of the
+    development machine, the same NaN in an earlier one)."""
     return np.where(np.isnan(a), np.nan, a).tobytes()
 
 
