@@ -64,32 +64,34 @@ def test_map_gamma_is_the_largest_product_on_the_envelope():
     from the cut up (:func:`decay.records`, the definition), and the latest time is that
     of the envelope: on a noisy decay with rises (points that are not on the envelope) and
     a zero norm (none), at rates below, at and above the decay's; from a cut below the
-    ladder (none of it left out), and over fewer levels than the pass takes at a time."""
+    ladder (none of it left out), and over fewer levels than a vector holds; with norms of
+    order one and of order 1e-6 (at the two lower rates every product then below one:
+    the logarithms all negative, whose maximum the pass must not take as their bits')."""
     import struct
 
     rng = np.random.default_rng(11)
     t = np.linspace(0.0, 6.0, 900)
-    v = np.exp(-2.0 * t + 0.7 * rng.standard_normal(t.size))
-    v[450] = 0.0
-    lt, lv, base = decay.ladders(1)
-    decay.ladder_clear(lt, 0)
-    base[0] = decay.ladder_base(v[0])
     bits = lambda x: struct.unpack("<q", struct.pack("<d", x))[0]  # noqa: E731
-    level = [min(max((bits(x) >> 49) - base[0], 0), decay.NBINS - 1) for x in v]
-    for i, x in enumerate(v):
-        lt[0, level[i]], lv[0, level[i]] = t[i], x
-    top = max(level)
-    u = np.empty(decay.NBINS)
-    for lo in (-3, 0, min(level) + 40, top - 60, top - 5, top):  # runs of 8 levels, a tail
-        above = {lev: i for i, lev in enumerate(level) if lev >= lo}  # last visit per level
-        later_max = np.maximum.accumulate(v[::-1])[::-1]  # the largest from each sample on
-        env = [i for i in above.values()
-               if v[i] > 0 and (i == v.size - 1 or later_max[i + 1] < v[i])]  # fmt: skip
-        for beta in (0.5, 2.0, 7.0):
-            gamma, t_end = decay.onestep._map_gamma(lt, lv, 0, lo, top, beta, u)
-            expect = max(v[i] * math.exp(beta * t[i]) for i in env)
-            assert gamma == pytest.approx(expect, rel=1e-14), (lo, beta)
-            assert t_end == max(t[i] for i in above.values())
+    for scale in (1.0, 1e-6):
+        v = scale * np.exp(-2.0 * t + 0.7 * rng.standard_normal(t.size))
+        v[450] = 0.0
+        lt, lv, base = decay.ladders(1)
+        decay.ladder_clear(lt, 0)
+        base[0] = decay.ladder_base(v[0])
+        level = [min(max((bits(x) >> 49) - base[0], 0), decay.NBINS - 1) for x in v]
+        for i, x in enumerate(v):
+            lt[0, level[i]], lv[0, level[i]] = t[i], x
+        top = max(level)
+        for lo in (-3, 0, min(level) + 40, top - 60, top - 5, top):  # a tail of a few levels
+            above = {lev: i for i, lev in enumerate(level) if lev >= lo}  # last visit per level
+            later_max = np.maximum.accumulate(v[::-1])[::-1]  # the largest from each sample on
+            env = [i for i in above.values()
+                   if v[i] > 0 and (i == v.size - 1 or later_max[i + 1] < v[i])]  # fmt: skip
+            for beta in (0.5, 2.0, 7.0):
+                gamma, t_end = decay.onestep._map_gamma(lt, lv, 0, lo, top, beta)
+                expect = max(v[i] * math.exp(beta * t[i]) for i in env)
+                assert gamma == pytest.approx(expect, rel=1e-14), (scale, lo, beta)
+                assert t_end == max(t[i] for i in above.values())
 
 
 def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():

@@ -61,6 +61,26 @@ def _from_bits_python(i):
 float_from_bits = _from_bits_python if config.DISABLE_JIT else _from_bits_intrinsic
 float_from_bits.__doc__ = """The float64 whose IEEE-754 bits are the int64 ``i``."""
 
+_LOW63 = 0x7FFFFFFFFFFFFFFF
+
+
+@njit(cache=True, forceinline=True)
+def ordered_key(x):
+    """An int64 in the order of the float64 ``x`` (not NaN): its bits, the magnitude bits
+    of a negative one flipped.  A maximum over such keys is an integer maximum, which
+    LLVM vectorizes as a reduction; a float maximum it vectorizes only when told that no
+    operand is NaN (numba's fast-math flags, which would reach the loop's other
+    arithmetic too)."""
+    i = float_bits(x)
+    return i ^ ((i >> 63) & _LOW63)
+
+
+@njit(cache=True, forceinline=True)
+def from_ordered_key(k):
+    """The float64 of :func:`ordered_key` ``k``."""
+    return float_from_bits(k ^ ((k >> 63) & _LOW63))
+
+
 # the natural logarithm of fdlibm (as in musl's log.c): x = 2^k (1 + f) with
 # 1 + f in [√2/2, √2), log(1 + f) = f − f²/2 + s (f²/2 + R(s²)), s = f / (2 + f)
 _LN2_HI = 6.93147180369123816490e-01

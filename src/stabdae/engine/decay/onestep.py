@@ -12,7 +12,16 @@ from numba import njit
 from ..jit import internal
 from ..workspace import stack1
 from .fit import FLOOR_MARGIN, MIN_DECADES, MIN_POINTS
-from .ladder import _TINY, LEVELS_PER_OCTAVE, NBINS, ladder_level, log_normal, trailing_zeros
+from .ladder import (
+    _TINY,
+    LEVELS_PER_OCTAVE,
+    NBINS,
+    from_ordered_key,
+    ladder_level,
+    log_normal,
+    ordered_key,
+    trailing_zeros,
+)
 from .record import (
     C_BETA,
     C_D2,
@@ -662,56 +671,39 @@ def _map_radius(S, j, ng, first, ref):
 
 
 @njit(cache=True, error_model="numpy")
-def _map_gamma(lt, lv, j, lo, top, beta, u):
+def _map_gamma(lt, lv, j, lo, top, beta):
     """``γ = max ‖g(t)‖ e^{βt}`` over the envelope's points on levels ``lo … top`` of
-    ladder row ``j``, and the latest time on them (``u``: scratch of ``NBINS``).
+    ladder row ``j``, and the latest time on them.
 
     Taken over every visited level, not only the envelope's: a level's last visit that
     is not on the envelope has a higher level visited later, whose larger norm at a later
     time gives a larger product (β > 0), so the maximum is the same.  Without the
-    envelope's running comparison, and with ``ln ‖g‖ + βt`` computed in a loop of its own
-    (branch-free: it vectorizes) and the exponential taken once, of the largest (it is
-    monotone), this costs a fraction of the envelope's loop with an exponential per
-    point, which was most of the cost of a member's end.  (A zero or subnormal norm,
-    where :func:`log_normal` does not hold, is left out: a zero's product is zero, and a
+    envelope's running comparison, with ``ln ‖g‖ + βt`` and the exponential taken once,
+    of the largest (it is monotone), in one branch-free loop whose maxima are integer
+    maxima of :func:`.ladder.ordered_key` (the same order as the floats': the same
+    maximum), which LLVM vectorizes whole.  (A zero or subnormal norm, where
+    :func:`log_normal` does not hold, is left out: a zero's product is zero, and a
     subnormal one, below 1e-308, lies on the ladder's bottom level, far under any
     transient.)
 
     The levels are indexed unsigned: numba wraps a negative index around, and an index
     that may be negative (``lo`` is not known to be ≥ 0) turns every load of the
-    vectorized loop into a gather and its store into a scatter (several times the time
-    of the whole pass).  The maxima are kept in eight running ones (a single one
-    is a chain of dependent comparisons); the maximum of a set is the same in any
-    order."""
+    vectorized loop into a gather (several times the time of the whole pass)."""
     lo = max(lo, 0)
     ltj = lt[j]
     lvj = lv[j]
+    best = ordered_key(-math.inf)
+    latest = ordered_key(-1.0)
     for i in range(top + 1 - lo):
         b = np.uint64(lo + i)
         t = ltj[b]
         v = lvj[b]
         ok = (t >= 0.0) & (v >= _TINY) & (v < math.inf)
-        u[b] = (log_normal(v if ok else 1.0) + beta * t) if ok else -math.inf
-    acc = stack1(16)  # eight running maxima of the products, eight of the times
-    for i in range(8):
-        acc[i] = -math.inf
-        acc[8 + i] = -1.0
-    b0 = lo
-    while b0 + 8 <= top + 1:
-        for i in range(8):
-            b = np.uint64(b0 + i)
-            acc[i] = max(acc[i], u[b])
-            acc[8 + i] = max(acc[8 + i], ltj[b])
-        b0 += 8
-    best = -math.inf
-    t_end = -1.0
-    for i in range(8):
-        best = max(best, acc[i])
-        t_end = max(t_end, acc[8 + i])
-    for b in range(b0, top + 1):
-        best = max(best, u[b])
-        t_end = max(t_end, ltj[b])
-    return (math.exp(best) if best > -math.inf else 0.0), t_end
+        w = (log_normal(v if ok else 1.0) + beta * t) if ok else -math.inf
+        best = max(best, ordered_key(w))
+        latest = max(latest, ordered_key(t))
+    top_w = from_ordered_key(best)
+    return (math.exp(top_w) if top_w > -math.inf else 0.0), from_ordered_key(latest)
 
 
 @njit(cache=True)
@@ -774,7 +766,7 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
         if not (rho < 1.0 and rho > 0.0):
             return False
         beta = -math.log(rho) / (gen_h if gen_h > 0.0 else tau)
-        gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta, ry)
+        gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta)
         out[C_BETA] = beta
         out[C_GAMMA] = gamma
         out[C_FIT_START] = 0.0
