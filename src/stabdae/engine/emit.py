@@ -36,6 +36,7 @@ import math
 import operator
 import textwrap
 import types as pytypes
+from functools import cache
 
 from numba import types
 from numba.core import cgutils
@@ -530,18 +531,15 @@ def emitted(fn_def, namespace: dict, label: str, fused: bool = HOST_FMA, params=
     if params is None:
         checked = _Function(fn_def, namespace, fused)
         params = checked.params
-        build = lambda: checked  # noqa: E731
+        function = lambda: checked  # noqa: E731
     else:
-        build = lambda: _Function(fn_def(), namespace, fused)  # noqa: E731
-    made: list = []
+        function = cache(lambda: _Function(fn_def(), namespace, fused))
     typings: dict = {}  # argument types -> _Typing
 
     def typer(typingctx, *argtypes):
         if len(argtypes) != len(params):
             return None
-        if not made:
-            made.append(build())
-        fn = made[0]
+        fn = function()
         if argtypes not in typings:
             typings[argtypes] = _Typing(fn, typingctx, argtypes)
         typing = typings[argtypes]

@@ -375,16 +375,17 @@ def _pieces(model, sparse: bool) -> Pieces:
                 f_t(t, q, p, sm)
             if FQ_V:
                 fq_v(fq, v, sm, g)
-            for i in range(0 if FQ_V else m):
-                s = sm[i] if HAS_FT else -0.0
-                if SPARSE:
-                    for e in range(FPTR[i], FPTR[i + 1]):
-                        j = FCOL[e]
-                        s = fma(fq[i, j], v[j], s)
-                else:
-                    for j in range(n):
-                        s = fma(fq[i, j], v[j], s)
-                g[m + i] = s
+            else:
+                for i in range(m):
+                    s = sm[i] if HAS_FT else -0.0
+                    if SPARSE:
+                        for e in range(FPTR[i], FPTR[i + 1]):
+                            j = FCOL[e]
+                            s = fma(fq[i, j], v[j], s)
+                    else:
+                        for j in range(n):
+                            s = fma(fq[i, j], v[j], s)
+                    g[m + i] = s
         if k > 0:
             h_fn(t, q, v, p, sk)
             for i in range(k):
@@ -655,16 +656,17 @@ def _build(model, spec: Spec) -> Kernels:
                 h_t(t, q, v, p, sk)
             if HQ_V:
                 hq_v(hq, v, sk, rl)
-            for i in range(0 if HQ_V else k):
-                s = -sk[i] if HAS_HT else -0.0
-                if SPARSE:
-                    for e in range(HQPTR[i], HQPTR[i + 1]):
-                        j = HQCOL[e]
-                        s = fma(-hq[i, j], v[j], s)
-                else:
-                    for j in range(n):
-                        s = fma(-hq[i, j], v[j], s)
-                rl[m + i] = s
+            else:
+                for i in range(k):
+                    s = -sk[i] if HAS_HT else -0.0
+                    if SPARSE:
+                        for e in range(HQPTR[i], HQPTR[i + 1]):
+                            j = HQCOL[e]
+                            s = fma(-hq[i, j], v[j], s)
+                    else:
+                        for j in range(n):
+                            s = fma(-hq[i, j], v[j], s)
+                    rl[m + i] = s
         if LAW == LAW_CONSTANT:
             for i in range(r):
                 s = rl[i]
