@@ -66,14 +66,16 @@ def test_map_gamma_is_the_largest_product_on_the_envelope():
     a zero norm (none), at rates below, at and above the decay's; from a cut below the
     ladder (none of it left out), and over fewer levels than a vector holds; with norms of
     order one and of order 1e-6 (at the two lower rates every product then below one:
-    the logarithms all negative, whose maximum the pass must not take as their bits')."""
+    the logarithms all negative); and on a plateau, a decay at the rate itself within
+    1e-4, where the first pass's logarithms (within 1e-4) order the products otherwise
+    than the exact ones."""
     import struct
 
     rng = np.random.default_rng(11)
     t = np.linspace(0.0, 6.0, 900)
     bits = lambda x: struct.unpack("<q", struct.pack("<d", x))[0]  # noqa: E731
-    for scale in (1.0, 1e-6):
-        v = scale * np.exp(-2.0 * t + 0.7 * rng.standard_normal(t.size))
+    for scale, noise in ((1.0, 0.7), (1e-6, 0.7), (1e-3, 1e-4)):
+        v = scale * np.exp(-2.0 * t + noise * rng.standard_normal(t.size))
         v[450] = 0.0
         lt, lv, base = decay.ladders(1)
         decay.ladder_clear(lt, 0)
@@ -82,16 +84,33 @@ def test_map_gamma_is_the_largest_product_on_the_envelope():
         for i, x in enumerate(v):
             lt[0, level[i]], lv[0, level[i]] = t[i], x
         top = max(level)
+        scratch = np.empty(decay.NBINS)
         for lo in (-3, 0, min(level) + 40, top - 60, top - 5, top):  # a tail of a few levels
             above = {lev: i for i, lev in enumerate(level) if lev >= lo}  # last visit per level
             later_max = np.maximum.accumulate(v[::-1])[::-1]  # the largest from each sample on
             env = [i for i in above.values()
                    if v[i] > 0 and (i == v.size - 1 or later_max[i + 1] < v[i])]  # fmt: skip
             for beta in (0.5, 2.0, 7.0):
-                gamma, t_end = decay.onestep._map_gamma(lt, lv, 0, lo, top, beta)
+                gamma, t_end = decay.onestep._map_gamma(lt, lv, 0, lo, top, beta, scratch)
                 expect = max(v[i] * math.exp(beta * t[i]) for i in env)
-                assert gamma == pytest.approx(expect, rel=1e-14), (scale, lo, beta)
+                assert gamma == pytest.approx(expect, rel=1e-14), (scale, noise, lo, beta)
                 assert t_end == max(t[i] for i in above.values())
+
+
+def test_log2_biased_is_within_its_bound():
+    """The first pass's logarithm is ``log2 x + 1023`` within ``LOG2_BOUND`` over the
+    normal floats: random ones over the whole range, and the ends of its mantissa's
+    interval, where a fitted polynomial strays most."""
+    from stabdae.engine.decay.ladder import LOG2_BOUND, log2_biased
+
+    rng = np.random.default_rng(5)
+    x = np.concatenate([np.exp2(rng.uniform(-1022.0, 1023.0, 20_000)),
+                        np.exp2(rng.integers(-1022, 1023, 200).astype(float)),
+                        [np.nextafter(2.0, 0.0), 1.5, 1.0 + 2.0**-52, 2.2250738585072014e-308,
+                         np.finfo(float).max]])  # fmt: skip
+    err = np.array([log2_biased(float(v)) for v in x]) - (np.log2(x) + 1023.0)
+    assert np.abs(err).max() <= LOG2_BOUND
+    assert np.abs(err).max() > 0.25 * LOG2_BOUND  # the bound is not loose past use
 
 
 def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
@@ -100,12 +119,14 @@ def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
     number exactly, since the sums of the last pairs are below the others' roundoff), also
     when the residual comes back above it (a floor's jitter): on a block of two members,
     one decaying with rises and one that jumps several bins at once, against the sums
-    taken pair by pair."""
+    taken pair by pair.  Every bin is written by the member's start (those above its
+    initial level), its falls or its end: none keeps what a slot held before (NaN)."""
     B, ng = 2, 2
 
     @njit
     def run(G):  # G[k, l, j]: the residual of member j at measured state k
         S = decay.map_buffers(B, ng, 1)
+        S[:] = np.nan  # a previous member's sums
         lt, lv, base = decay.ladders(B)
         Dv, P, A = np.zeros((ng, B)), np.zeros((ng, B)), np.zeros((10, B))
         gn, dn, gr = np.zeros(B), np.zeros(B), np.zeros(ng)
@@ -119,6 +140,7 @@ def test_map_bins_hold_the_pairs_before_the_first_fall_below_each():
                 for j in range(B):
                     base[j] = decay.ladder_base(dn[j])
                     low[j] = decay.ladder_level(dn[j], base[j]) >> decay.MAP_SHIFT
+                    decay.map_begin(S, j, low[j])
             decay.pairs_pooled(Dv, P, A, 1.0 if k > 0 else 0.0, 1)
             changed = decay.block_levels(gn, dn, base, low, nlev, wmax, dmax)
             if changed != 0:

@@ -47,7 +47,7 @@ BRENT_TOL = 3e-5
 
 
 # --------------------------------------------------------------------- fits
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _solve3(a, b):
     """Solve the 3×3 system ``a x = b`` by Gaussian elimination with partial pivoting;
     returns False when it is singular.  ``a`` and ``b`` are overwritten."""
@@ -75,7 +75,7 @@ def _solve3(a, b):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _centered_sums(rt, ry, start, end):
     """Means of ``t`` and ``y`` on [start, end) and the centred sums ``Σ(t − t̄)²``,
     ``Σ(t − t̄)(y − ȳ)``, ``Σ(y − ȳ)²`` of both regressions."""
@@ -93,7 +93,7 @@ def _centered_sums(rt, ry, start, end):
     return tm, ym, stt, sty, syy
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _fit_linear(rt, ry, start, end):
     """Least squares ``y ≈ c − β t`` on points [start, end); returns (β, SSE)."""
     tm, ym, stt, sty, _ = _centered_sums(rt, ry, start, end)
@@ -107,7 +107,7 @@ def _fit_linear(rt, ry, start, end):
     return -slope, sse
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _fit_inverse(rt, ry, start, end):
     """Least squares ``t ≈ a + b y`` on [start, end); returns ``β = −1/b``."""
     _, _, _, sty, syy = _centered_sums(rt, ry, start, end)
@@ -116,7 +116,7 @@ def _fit_inverse(rt, ry, start, end):
     return -syy / sty
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _shift_free_sums(rt, ry, start, end):
     """The sums of the ``ν log(t + s)`` fit's normal equations that do not depend on the
     shift (the count, ``Σ −t``, ``Σ t²``, ``Σ y``, ``Σ −t y`` on [start, end)): formed once
@@ -132,14 +132,14 @@ def _shift_free_sums(rt, ry, start, end):
     return s00, s01, s11, b0, b1
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, forceinline=True, _nrt=False)
 def _residual2(rt, ry, lg, i, c0, c1, c2):
     """The squared residual of point ``i`` of the fit ``y ≈ c0 − c1 t + c2 log(t + s)``."""
     r = ry[i] - c0 + c1 * rt[i] - c2 * lg[i]
     return r * r
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _fit_with_log(rt, ry, start, end, shift, a, b, lg, fixed):
     """Least squares ``y ≈ c − β t + ν log(t + shift)`` on [start, end); returns (β, SSE),
     SSE = inf when the normal equations are singular.  ``fixed``: the shift-free sums
@@ -183,7 +183,7 @@ def _fit_with_log(rt, ry, start, end, shift, a, b, lg, fixed):
     return c1, (e0 + e1) + (e2 + e3)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _brent(rt, ry, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg, fixed):
     """Brent's minimization (parabolic steps, golden sections when they fail) of the
     ``ν log(t + s)`` fit's SSE over ``u = log(s + t_w)`` in ``[lo_u, hi_u]``, from the
@@ -246,7 +246,7 @@ def _brent(rt, ry, start, end, t_w, lo_u, hi_u, x, fx, bx, a, b, lg, fixed):
     return best, beta, ubest
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _fit_polynomial(rt, ry, start, end, dt, a, b, lg, hint=math.nan):
     """The ``ν log(t + s)`` fit with the best shift: a log-spaced grid of shifts
     ``s = e^u − t_w`` over ``(−t_w, ∞)`` (``t_w`` the window's first time: a negative
@@ -288,7 +288,7 @@ def _fit_polynomial(rt, ry, start, end, dt, a, b, lg, hint=math.nan):
     return beta, best, math.exp(u) - t_w
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _window(rt, ry, n, floor, still_decaying):
     """The fit window ``[start, end)`` of the envelope points: the transient (down to a
     margin above the floor, or all points when the run ended still decaying) after its
@@ -321,7 +321,7 @@ def _window(rt, ry, n, floor, still_decaying):
     return 0, 0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code):
     """β, γ and the fit's window, kind and shift from the ``n`` envelope points into
     ``out`` and ``code`` (a member's row of the record's floats and integers; ``reason``
@@ -370,7 +370,7 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code):
     code[I_REASON] = R_FITTED
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def refit(rt, ry, n, t_lo, t_hi, kind, dt, a, b, lg, shift=math.nan):
     """β of the envelope points with times in ``[t_lo, t_hi]`` by the fit ``kind`` (the
     measured member's window and kind, for its prediction; ``shift`` its shift, where

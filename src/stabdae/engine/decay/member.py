@@ -9,7 +9,7 @@ from numba import njit
 
 from .fit import MIN_DECADES, STILL_DECAYING, estimate, grows, refit
 from .ladder import ladder_base, ladder_clear, ladder_level, records
-from .onestep import map_estimate, spectral_radius_of
+from .onestep import map_estimate
 from .record import (
     C_BETA,
     C_BETA_PRED,
@@ -62,7 +62,7 @@ def observe(lt, lv, base, meas, j, row, t, v, d, window):  # costs as much as th
                 meas[row, c] = d
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def begin(lt, lv, base, meas, codes, j, row, g0, d0):
     """Start member ``row`` on ladder row ``j`` with its initial norms (as
     :func:`observe`'s); every column of its record is written here or at its end."""
@@ -80,7 +80,7 @@ def begin(lt, lv, base, meas, codes, j, row, g0, d0):
     observe(lt, lv, base, meas, j, row, 0.0, g0, d0, 0)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def finish(lt, lv, meas, codes, j, row, final, stopped, dt, rt, ry, a, b, lg):
     """Member ``row``'s measures from ladder row ``j`` at the end of its run (``final``:
     the norm at its last state; ``stopped``: it did not run to the end)."""
@@ -105,12 +105,11 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
     still = summarize(meas, codes, row, final, stopped)
     if stopped:
         return
-    out = meas[row]
     # a late rise a decade or more below the start is the floor moving with the motion
     # (the member drifting from the reference), not growth: the map reads the transient
     # before it
-    drift = out[C_D4] * 10.0**MIN_DECADES <= out[C_INITIAL]
-    if grows(out[C_D2], out[C_D3], out[C_D4]) and not drift:
+    drift = meas[row, C_D4] * 10.0**MIN_DECADES <= meas[row, C_INITIAL]
+    if grows(meas[row, C_D2], meas[row, C_D3], meas[row, C_D4]) and not drift:
         fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
@@ -125,7 +124,7 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
             codes[row, I_REASON] = R_NO_TRANSIENT
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg):
     """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
     ``still``: the run ended while it was decaying)."""
@@ -133,7 +132,7 @@ def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg):
     estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row], codes[row])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def summarize(meas, codes, row, final, stopped):
     """Member ``row``'s columns other than the fit at the end of its run (``final``: the
     norm at its last state; ``stopped``: it did not run to the end; then the fit's
@@ -162,21 +161,20 @@ def summarize(meas, codes, row, final, stopped):
     return still
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def predict(R, alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b, lg, g, gn,
-            rho_R=math.nan):  # fmt: skip
+            rho_R):  # fmt: skip
     """Member ``row``'s predicted rate: ``g_{k+1} = R g_k`` from ``g_0 = alpha`` over the
     steps up to its fit window's end, through ladder row ``j``, fitted over the measured
     window with the measured kind; ``−ln ρ(R)/h`` for a member measured by its one-step
-    map (``rho_R``: ``ρ(R)`` when known).  ``g``, ``gn`` are scratch of the residual's
-    size."""
+    map (``rho_R``: :func:`.onestep.spectral_radius_of` ``R``, taken once for all).
+    ``g``, ``gn`` are scratch of the residual's size."""
     out = meas[row]
     out[C_BETA_PRED] = math.nan
     if codes[row, I_REASON] != R_FITTED:
         return
     if codes[row, I_KIND] == K_MAP:  # the map fitted to g_{k+1} = R g_k is R itself
-        rho = rho_R if rho_R == rho_R else spectral_radius_of(R)
-        out[C_BETA_PRED] = -math.log(rho) / h
+        out[C_BETA_PRED] = -math.log(rho_R) / h
         return
     ng = alpha.shape[0]
     ladder_clear(lt, j)

@@ -9,17 +9,20 @@ import math
 import numpy as np
 from numba import njit
 
+from ..fma import fma
 from ..jit import internal
 from ..workspace import stack1
 from .fit import FLOOR_MARGIN, MIN_DECADES, MIN_POINTS
 from .ladder import (
     _TINY,
     LEVELS_PER_OCTAVE,
+    LOG2_BOUND,
     NBINS,
-    from_ordered_key,
+    float_bits,
+    float_from_bits,
     ladder_level,
+    log2_biased,
     log_normal,
-    ordered_key,
     trailing_zeros,
 )
 from .record import (
@@ -94,10 +97,12 @@ def map_width(ng, pm):
     return 2 * ng * ng + 1 if ng <= MAP_MAX_NG else 0
 
 
-@njit(cache=True)
-def map_begin(S, j):
-    """Clear slot ``j``'s sums for a new member."""
-    for b in range(S.shape[1]):
+@njit(cache=True, _nrt=False)
+def map_begin(S, j, low):
+    """Slot ``j``'s sums for a new member, whose initial level is in bin ``low``: those
+    of the bins above it cleared (no pair comes before a fall below them).  The others
+    are written before the member's end (:func:`bin_flush`, :func:`end_flush`)."""
+    for b in range(low + 1, S.shape[1]):
         for c in range(S.shape[2]):
             S[j, b, c] = 0.0
 
@@ -255,7 +260,7 @@ def bin_flush(S, A, nlev, low, mask, pooled, full):
 @njit(cache=True, error_model="numpy")
 def end_flush(S, A, low, active, pooled, full):
     """At the end of the run: each running slot's sums as those of the bins it did not go
-    below."""
+    below (all of them, zero, when no state was measured)."""
     for j in range(low.shape[0]):
         if active[j]:
             for b in range(low[j] + 1):
@@ -355,7 +360,7 @@ def flushes_for(FULL: int):
     return bin_flush_full, end_flush_full
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _cluster_radius(moduli, n):
     """The largest modulus, or the geometric mean of those within ``CLUSTER`` of it in
     rate (``ln`` of the modulus): a repeated eigenvalue (a Jordan block, as critically
@@ -453,7 +458,7 @@ def is_scalar_law(ref):
     return ref.shape[0] == 1 and math.isfinite(ref[0])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _grouped(moduli, n, ref):
     """The rate a fitted map's eigenvalue moduli give, read in the groups of the law's
     spectrum ``ref`` (:func:`reference_logs`): each modulus joins the group of the nearest
@@ -465,30 +470,35 @@ def _grouped(moduli, n, ref):
     moduli within ``CLUSTER`` of the largest in rate (:func:`_cluster_radius`)."""
     if ref.shape[0] == 0 or not (ref[0] == ref[0]):
         return _cluster_radius(moduli, n)
-    best = -1
     for i in range(n):
         if not (moduli[i] > 0.0) or moduli[i] == math.inf:
             return _cluster_radius(moduli, n)
-    groups = np.empty(n, dtype=np.int64)
+    best = -1
     for i in range(n):
-        x = math.log(moduli[i])
-        g = 0
-        for c in range(ref.shape[0]):
-            if ref[c] == ref[c] and abs(x - ref[c]) < abs(x - ref[g]):
-                g = c
-        groups[i] = g
+        g = _nearest(math.log(moduli[i]), ref)
         if best < 0 or ref[g] > ref[best]:
             best = g
     logs = 0.0
     count = 0
-    for i in range(n):
-        if groups[i] == best:
-            logs += math.log(moduli[i])
+    for i in range(n):  # (each modulus's group found again: no array to keep them in)
+        x = math.log(moduli[i])
+        if _nearest(x, ref) == best:
+            logs += x
             count += 1
     return math.exp(logs / count)
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True, _nrt=False)
+def _nearest(x, ref):
+    """The index of the entry of ``ref`` (:func:`reference_logs`) nearest ``x``."""
+    g = 0
+    for c in range(ref.shape[0]):
+        if ref[c] == ref[c] and abs(x - ref[c]) < abs(x - ref[g]):
+            g = c
+    return g
+
+
+@njit(cache=True, _nrt=False)
 def _radius2_grouped(r00, r01, r10, r11, ref):
     """``ρ`` of the fitted 2 × 2 map ``[[r00, r01], [r10, r11]]`` read in the groups of
     the law's spectrum (:func:`_grouped`); :func:`_radius2` without it."""
@@ -509,7 +519,7 @@ def _radius2_grouped(r00, r01, r10, r11, ref):
     return _grouped(m, 2, ref)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _radius2(r00, r01, r10, r11):
     """:func:`spectral_radius_of` of the 2 × 2 matrix ``[[r00, r01], [r10, r11]]`` in
     closed form, without arrays (NaN for non-finite entries)."""
@@ -572,7 +582,7 @@ def _moduli(R):
     return moduli
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _pooled_radius(S, j, first, ref):
     """``ρ`` of the pooled fits (:func:`map_buffers`): the larger of the 2 × 2 map of
     the ``(f_i, ḟ_i)`` pairs and the 1 × 1 map of the ``h_j``, each where it has data,
@@ -670,21 +680,25 @@ def _map_radius(S, j, ng, first, ref):
     return grouped_radius_of(Rr, ref), pairs
 
 
-@njit(cache=True, error_model="numpy")
-def _map_gamma(lt, lv, j, lo, top, beta):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _map_gamma(lt, lv, j, lo, top, beta, w):
     """``γ = max ‖g(t)‖ e^{βt}`` over the envelope's points on levels ``lo … top`` of
-    ladder row ``j``, and the latest time on them.
+    ladder row ``j``, and the latest time on them (``β > 0``; ``w``: scratch of
+    ``NBINS``).
 
     Taken over every visited level, not only the envelope's: a level's last visit that
     is not on the envelope has a higher level visited later, whose larger norm at a later
     time gives a larger product (β > 0), so the maximum is the same.  Without the
-    envelope's running comparison, with ``ln ‖g‖ + βt`` and the exponential taken once,
-    of the largest (it is monotone), in one branch-free loop whose maxima are integer
-    maxima of :func:`.ladder.ordered_key` (the same order as the floats': the same
-    maximum), which LLVM vectorizes whole.  (A zero or subnormal norm, where
-    :func:`log_normal` does not hold, is left out: a zero's product is zero, and a
-    subnormal one, below 1e-308, lies on the ladder's bottom level, far under any
-    transient.)
+    envelope's running comparison, as the largest ``ln ‖g‖ + βt`` (the exponential taken
+    once, of the largest: it is monotone), in two passes.  The first, branch-free, which
+    LLVM vectorizes whole, takes ``log2 ‖g‖ + βt/ln 2`` within ``LOG2_BOUND``
+    (:func:`.ladder.log2_biased`), positive, so that its maximum is an integer maximum of
+    the bits (as is the latest time's: a visited level's time is ≥ 0, an unvisited one's
+    −1, whose bits are negative).  The second takes the exact ``ln ‖g‖ + βt``
+    (:func:`log_normal`) on the levels that came within twice the bound of the first's
+    largest only: the largest exact one is among them.  (A zero or subnormal norm, where
+    neither logarithm holds, is left out: a zero's product is zero, and a subnormal one,
+    below 1e-308, lies on the ladder's bottom level, far under any transient.)
 
     The levels are indexed unsigned: numba wraps a negative index around, and an index
     that may be negative (``lo`` is not known to be ≥ 0) turns every load of the
@@ -692,18 +706,30 @@ def _map_gamma(lt, lv, j, lo, top, beta):
     lo = max(lo, 0)
     ltj = lt[j]
     lvj = lv[j]
-    best = ordered_key(-math.inf)
-    latest = ordered_key(-1.0)
-    for i in range(top + 1 - lo):
+    n = top + 1 - lo
+    rate = beta / math.log(2.0)
+    best = float_bits(0.0)
+    latest = float_bits(-1.0)
+    for i in range(n):
         b = np.uint64(lo + i)
         t = ltj[b]
         v = lvj[b]
         ok = (t >= 0.0) & (v >= _TINY) & (v < math.inf)
-        w = (log_normal(v if ok else 1.0) + beta * t) if ok else -math.inf
-        best = max(best, ordered_key(w))
-        latest = max(latest, ordered_key(t))
-    top_w = from_ordered_key(best)
-    return (math.exp(top_w) if top_w > -math.inf else 0.0), from_ordered_key(latest)
+        x = fma(rate, t, log2_biased(v)) if ok else 0.0
+        w[np.uint64(i)] = x
+        best = max(best, float_bits(x))
+        latest = max(latest, float_bits(t))
+    if best == float_bits(0.0):
+        return 0.0, float_from_bits(latest)
+    rough = float_from_bits(best)
+    # (the margin past 2 LOG2_BOUND: the roundoff of keys up to ~10³)
+    cut = rough - 2.0 * LOG2_BOUND - 1e-12 * rough
+    top_w = -math.inf
+    for i in range(n):
+        if w[np.uint64(i)] >= cut:
+            b = np.uint64(lo + i)
+            top_w = max(top_w, log_normal(lvj[b]) + beta * ltj[b])
+    return math.exp(top_w), float_from_bits(latest)
 
 
 @njit(cache=True)
@@ -729,12 +755,11 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
     the least floor the cut is taken from (an adaptive member's distance from the
     reference has a floor of its own, the local errors of steps that fall apart from the
     reference's, which its last fifth may not show).  Returns whether it gave β."""
-    out = meas[row]
     if S.shape[2] == 0:
         return False
-    floor = max(out[C_D4], floor_min)
-    still = (out[C_D2] > out[C_D3] > out[C_D4]
-             and out[C_D2] >= MAP_STILL_DECAYING * out[C_D4])  # fmt: skip
+    floor = max(meas[row, C_D4], floor_min)
+    still = (meas[row, C_D2] > meas[row, C_D3] > meas[row, C_D4]
+             and meas[row, C_D2] >= MAP_STILL_DECAYING * meas[row, C_D4])  # fmt: skip
     top = -1
     for b in range(NBINS - 1, -1, -1):
         if lt[j, b] >= 0.0:
@@ -766,16 +791,16 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
         if not (rho < 1.0 and rho > 0.0):
             return False
         beta = -math.log(rho) / (gen_h if gen_h > 0.0 else tau)
-        gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta)
-        out[C_BETA] = beta
-        out[C_GAMMA] = gamma
-        out[C_FIT_START] = 0.0
-        out[C_FIT_END] = t_end
-        out[C_SHIFT] = math.nan
-        code = codes[row]
-        code[I_POINTS] = pairs
-        code[I_KIND] = K_MAP
-        code[I_REASON] = R_FITTED
+        gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta,
+                                  ry)
+        meas[row, C_BETA] = beta
+        meas[row, C_GAMMA] = gamma
+        meas[row, C_FIT_START] = 0.0
+        meas[row, C_FIT_END] = t_end
+        meas[row, C_SHIFT] = math.nan
+        codes[row, I_POINTS] = pairs
+        codes[row, I_KIND] = K_MAP
+        codes[row, I_REASON] = R_FITTED
         return True
     return False
 

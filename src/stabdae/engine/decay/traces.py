@@ -11,6 +11,7 @@ from numba import njit
 from ..threads import run_chunks
 from .ladder import ladders, scratch
 from .member import begin, finish, observe, predict
+from .onestep import spectral_radius_of
 from .record import Record
 
 
@@ -24,6 +25,7 @@ def _measure_rows(norms, times, meas, codes, R, alphas, lo, hi):
     dt = times[1] - times[0] if T > 1 else 1.0
     g = np.empty(alphas.shape[1])
     gn = np.empty(alphas.shape[1])
+    rho_R = spectral_radius_of(R) if R.shape[0] > 0 else math.nan
     for r in range(lo, hi):
         begin(lt, lv, base, meas, codes, 0, r, norms[r, 0], norms[r, 0])
         last = norms[r, 0]
@@ -39,7 +41,7 @@ def _measure_rows(norms, times, meas, codes, R, alphas, lo, hi):
         finish(lt, lv, meas, codes, 0, r, last, stopped, dt, rt, ry, a, b, lg)
         if R.shape[0] > 0:
             predict(R, alphas[r], T - 1, dt, lt, lv, base, meas, codes, 0, r, rt, ry, a, b, lg,
-                    g, gn)  # fmt: skip
+                    g, gn, rho_R)  # fmt: skip
 
 
 def measure_traces(norms, times, R=None, alpha0=None):

@@ -548,7 +548,7 @@ def build_block_kernel(K, spec: Spec):
                 if trace_row[lo + j] >= 0:
                     out_norm[trace_row[lo + j], 0] = nrm
                 begin(lt, lv, base, meas, mcodes, j, lo + j, nrm, dn_b[j])
-                map_begin(S_map, j)
+                map_begin(S_map, j, low[j])
                 active[j] = True
                 alive += 1
                 if not (nrm <= threshold):
@@ -648,8 +648,8 @@ def build_block_kernel(K, spec: Spec):
                 for l in range(ng):
                     g_out[nsteps, l] = Gb[l, 0]
             windows_flush(meas, wmax, dmax, window, active, lo, cnt)
-            if k_last >= 0:  # the sums of the bins not gone below
-                end_flush(S_map, Am, low, active, pooled_, full_)
+            # the sums of the bins not gone below (map_begin cleared only those above)
+            end_flush(S_map, Am, low, active, pooled_, full_)
             for j in range(cnt):
                 final = math.nan
                 if active[j]:

@@ -30,6 +30,7 @@ from ..decay import (
     predict,
     reference_logs,
     scratch,
+    spectral_radius_of,
 )
 from ..rhs import kernels_for
 from ..rk.adaptive import _pattern, attempt_for
@@ -286,6 +287,7 @@ def _build_adaptive_block(K, spec: Spec):
         S_g = np.zeros((B, MAP_BINS, GW))
         low = np.zeros(B, dtype=np.int64)
         ref = reference_logs(R)
+        rho_R = spectral_radius_of(R) if R.shape[0] > 0 else math.nan
         g_p = np.empty(alpha0s.shape[1])
         gn_p = np.empty(alpha0s.shape[1])
         nxt = lo
@@ -392,7 +394,7 @@ def _build_adaptive_block(K, spec: Spec):
                     if R.shape[0] > 0:
                         predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt, lv,
                                 base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
-                                gn_p)  # fmt: skip
+                                gn_p, rho_R)  # fmt: skip
                     mem[lane] = -1
                     alive -= 1
                 while mem[lane] < 0 and nxt < hi:  # the next waiting member
@@ -462,7 +464,7 @@ def _build_adaptive_block(K, spec: Spec):
                         if R.shape[0] > 0:
                             predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt,
                                     lv, base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
-                                    gn_p)  # fmt: skip
+                                    gn_p, rho_R)  # fmt: skip
                         continue
                     mem[lane] = i
                     alive += 1
