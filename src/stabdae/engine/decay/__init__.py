@@ -131,6 +131,7 @@ from .onestep import (  # noqa: F401
     pairs_pooled,
     reference_logs,
     spectral_radius_of,
+    window_flush,
     windows_flush,
 )
 from .record import (  # noqa: F401

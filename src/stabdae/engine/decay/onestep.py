@@ -273,17 +273,25 @@ def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
     then cleared."""
     for j in range(cnt):
         if active[j]:
-            row = lo + j
-            c = C_W0 + window
-            if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
-                meas[row, c] = wmax[j]
-            if window >= 2:
-                c = C_D2 + window - 2
-                if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
-                    meas[row, c] = dmax[j]
+            window_flush(meas, wmax, dmax, window, j, lo + j)
     for j in range(wmax.shape[0]):
         wmax[j] = -math.inf
         dmax[j] = -math.inf
+
+
+@njit(cache=True, forceinline=True, error_model="numpy")
+def window_flush(meas, wmax, dmax, window, j, row):
+    """Slot ``j``'s largest norms of fifth ``window`` so far to its member's row ``row``
+    (kept in the slot: a largest norm flushed twice is the same largest norm).  Each
+    member's are flushed when the fifth ends (:func:`windows_flush`), or before it
+    stops."""
+    c = C_W0 + window
+    if wmax[j] > -math.inf and not (meas[row, c] >= wmax[j]):
+        meas[row, c] = wmax[j]
+    if window >= 2:
+        c = C_D2 + window - 2
+        if dmax[j] > -math.inf and not (meas[row, c] >= dmax[j]):
+            meas[row, c] = dmax[j]
 
 
 def pairs_full_for(B: int, ng: int):
