@@ -47,6 +47,7 @@ BRENT_TOL = 3e-5
 
 
 # --------------------------------------------------------------------- fits
+# (compiled without reference counting, as the member's functions: :mod:`.member`)
 @njit(cache=True, _nrt=False)
 def _solve3(a, b):
     """Solve the 3×3 system ``a x = b`` by Gaussian elimination with partial pivoting;

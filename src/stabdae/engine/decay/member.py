@@ -42,6 +42,11 @@ from .record import (
 
 
 # --------------------------------------------------------------------- per member
+# The functions here that allocate nothing (all but finish_with_map, whose map estimate
+# may) are compiled without numba's reference counting (``_nrt=False``): a separately
+# compiled function otherwise takes and drops a reference to each array argument, two
+# atomic operations per array per call, for every member.  Such a function cannot call
+# one that allocates.
 @njit(cache=True, forceinline=True)  # once per accepted step: a call with four arrays
 def observe(lt, lv, base, meas, j, row, t, v, d, window):  # costs as much as the step
     """Step time ``t`` (from the start) of member ``row`` (ladder row ``j``), in fifth

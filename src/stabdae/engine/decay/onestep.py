@@ -368,6 +368,8 @@ def flushes_for(FULL: int):
     return bin_flush_full, end_flush_full
 
 
+# (the radii that allocate nothing, and γ's pass: compiled without reference counting,
+# as the member's functions, :mod:`.member`)
 @njit(cache=True, _nrt=False)
 def _cluster_radius(moduli, n):
     """The largest modulus, or the geometric mean of those within ``CLUSTER`` of it in

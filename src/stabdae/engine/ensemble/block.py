@@ -632,8 +632,9 @@ def build_block_kernel(K, spec: Spec):
                                 fail_step[lo + j] = i
                                 alive -= 1
                                 # its largest norms of the fifth (the others' wait for
-                                # its end: a flush of the block at every stored sample
-                                # cost 0.2 µs a member over 2 s)
+                                # the fifth's end: a flush of the whole block at every
+                                # stored sample was a loop over its members' rows each
+                                # time)
                                 window_flush(meas, wmax, dmax, window, j, lo + j)
                                 for l in range(N2):
                                     xs_h[l] = X[l, j]
