@@ -19,6 +19,12 @@ Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored e
 * NumPy vectorized over members;
 * JAX ``lax.scan`` + ``vmap`` when jax is installed.
 
+The kernel without the measurement and the blocked C also run on one thread each: where
+the machine's threads share a physical core (SMT), a thread that keeps the core's vector
+units busy (the C) gains little from a second, while one that waits on its own
+instructions' latencies gains nearly double, and the ratio on all threads hides the
+ratio per thread.
+
 All start from the same sampled initial states; the final states are compared to make
 sure every variant computes the same thing.  OpenMP's workers sleep between parallel
 regions (``OMP_WAIT_POLICY=PASSIVE`` unless set otherwise): by default they spin for a
@@ -80,6 +86,8 @@ def build_c(*extra: str) -> ctypes.CDLL:
     for name in ("run_scalar", "run_blocked"):
         getattr(lib, name).argtypes = argtypes
         getattr(lib, name).restype = None
+    lib.set_threads.argtypes = [ctypes.c_int]
+    lib.set_threads.restype = None
     return lib
 
 
@@ -114,6 +122,25 @@ def run_kernel(model, law, x0, divergence, nsteps, measure=True):
     start = time.perf_counter()
     out = run.mode.integrate(run, x0, alpha0, status, g_ref)
     return time.perf_counter() - start, out.x_final
+
+
+def one_thread(model, law, x0, divergence, lib, repeat):
+    """The kernel without the measurement and the blocked C, each on one thread (best of
+    ``repeat``, in turn): where the threads share a physical core (SMT), a thread that
+    keeps the core's vector units busy leaves the second little to add, and the ratio at
+    the full thread count says nothing of the ratio per thread."""
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    lib.set_threads(1)
+    try:
+        kernel = c = np.inf
+        for _ in range(repeat):
+            kernel = min(kernel, run_kernel(model, law, x0, divergence, NSTEPS, measure=False)[0])
+            c = min(c, run_c(lib.run_blocked, x0)[0])
+    finally:
+        numba.set_num_threads(threads)
+        lib.set_threads(threads)
+    return kernel, c
 
 
 def member_ends(model, law, x0, divergence, repeat, short=SAVE_EVERY):
@@ -283,6 +310,8 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
             t_ieee = min(t_ieee, run_c(lib_ieee.run_blocked, x0)[0])
         assert np.array_equal(xf_kernel, ds.x_final.values)
         assert np.array_equal(xf_step, xf_kernel)  # the measurement changes no state
+        one_kernel, one_c = one_thread(model, law, x0, ds.attrs["divergence"], lib,
+                                       max(1, args.repeat))  # fmt: skip
         ends = member_ends(model, law, x0, ds.attrs["divergence"], max(1, args.repeat))
         ends_map = member_ends(model, law, x0, ds.attrs["divergence"], max(1, args.repeat),
                                short=MAP_ENDS_STEPS)  # fmt: skip
@@ -294,6 +323,7 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
                "stabdae_kernel_step_only_s": step_only,
                "stabdae_step_slope_s": 2.0 * (step_only - half),
                "member_ends_core_us": ends, "member_ends_map_core_us": ends_map,
+               "one_thread_kernel_step_only_s": one_kernel, "one_thread_c_blocked_s": one_c,
                "c_scalar_s": t_scalar, "c_blocked_s": t_blocked,
                "c_blocked_no_fma_s": t_ieee,
                "max_diff_vs_c": float(np.max(np.abs(xs - xf_blocked)))}  # fmt: skip
@@ -326,6 +356,9 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
             variants.append(("JAX scan + vmap", row["jax_s"]))
         for name, secs in variants:
             print(f"{name:<34} {secs:9.3f} {steps / secs:15.3g} {t_blocked / secs:15.3f}")
+        print(f"one thread each: the kernel without the measurement {one_kernel:.3f} s, the "
+              f"blocked C {one_c:.3f} s: {one_c / one_kernel:.3f} of the C (the C's time on "
+              f"{numba.get_num_threads()} threads is {t_blocked / one_c:.2f} of its time on one)")
         print(f"each member's start and end in the kernel: {ends:.3f} µs of core time "
               f"(runs of {SAVE_EVERY} and {2 * SAVE_EVERY} steps), {ends_map:.3f} µs (runs "
               f"of {MAP_ENDS_STEPS} and {2 * MAP_ENDS_STEPS} steps; "

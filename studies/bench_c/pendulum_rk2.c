@@ -13,9 +13,13 @@
  * members / blocks.
  */
 #include <math.h>
+#include <omp.h>
 #include <stdint.h>
 
 #define BLOCK 64
+
+/* the OpenMP threads of the runs that follow (the benchmark's one-thread rows) */
+void set_threads(int n) { omp_set_num_threads(n); }
 
 static inline void rhs(double x, double y, double vx, double vy, double g, double l,
                        double a0, double a1, double *ax, double *ay) {
