@@ -19,11 +19,10 @@ Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored e
 * NumPy vectorized over members;
 * JAX ``lax.scan`` + ``vmap`` when jax is installed.
 
-The kernel without the measurement and the blocked C also run on one thread each: where
-the machine's threads share a physical core (SMT), a thread that keeps the core's vector
-units busy (the C) gains little from a second, while one that waits on its own
-instructions' latencies gains nearly double, and the ratio on all threads hides the
-ratio per thread.
+The kernel without the measurement and the blocked C also run on one thread each (set
+through the C's ``set_threads``: ``OMP_NUM_THREADS`` in the environment is not read once
+the process has started OpenMP), so that the ratio is given per thread count: where
+threads share a core (SMT) or memory bandwidth, the two can scale differently.
 
 All start from the same sampled initial states; the final states are compared to make
 sure every variant computes the same thing.  OpenMP's workers sleep between parallel
@@ -126,9 +125,7 @@ def run_kernel(model, law, x0, divergence, nsteps, measure=True):
 
 def one_thread(model, law, x0, divergence, lib, repeat):
     """The kernel without the measurement and the blocked C, each on one thread (best of
-    ``repeat``, in turn): where the threads share a physical core (SMT), a thread that
-    keeps the core's vector units busy leaves the second little to add, and the ratio at
-    the full thread count says nothing of the ratio per thread."""
+    ``repeat``, in turn)."""
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
     lib.set_threads(1)
