@@ -34,15 +34,20 @@ def test_measures_of_stored_traces_match_numpy():
     assert meas["reason"][3] == decay.R_STOPPED and np.isnan(meas["beta"][3])
 
 
-def test_ladder_records_are_the_right_envelope():
+@pytest.mark.parametrize("below", [None, 0, 3])
+def test_ladder_records_are_the_right_envelope(below):
     """The ladder's points are, level by level, the last sample on that level, and exactly
-    those of them that no later sample exceeds (the right envelope), in time order."""
+    those of them that no later sample exceeds (the right envelope), in time order.  The
+    scan may stop at the lowest level visited (``lowest``, as a member's end passes it:
+    the same points) and reads no level below the one given (``below`` levels above the
+    lowest visited: the points of the levels below are left out)."""
     import struct
 
     from stabdae.engine import decay
 
     rng = np.random.default_rng(4)
     v = np.exp(-np.linspace(0, 12, 700) + 2.0 * rng.standard_normal(700))
+    v[-1] = v.min() * 1e-3  # the last sample, on the envelope, on the lowest level
     lt, lv, base = decay.ladders(1)
     rt, ry = np.empty(decay.NBINS), np.empty(decay.NBINS)
     decay.ladder_clear(lt, 0)
@@ -51,11 +56,16 @@ def test_ladder_records_are_the_right_envelope():
     level = [min(max((bits(x) >> 49) - base[0], 0), decay.NBINS - 1) for x in v]
     for i, x in enumerate(v):
         lt[0, level[i]], lv[0, level[i]] = float(i), x
-    n = decay.records(lt, lv, 0, rt, ry)
-    last_on_level = {lev: i for i, lev in enumerate(level)}
-    expect = sorted(i for i in last_on_level.values() if i == v.size - 1 or v[i] > v[i + 1:].max())
+    lowest = 0 if below is None else min(level) + below
+    assert lowest < decay.NBINS - 100  # (the full scan's 512 levels are not all visited)
+    n = decay.records(lt, lv, 0, rt, ry, *(() if below is None else (lowest,)))
+    last_on_level = {lev: i for i, lev in enumerate(level) if lev >= lowest}
+    kept = list(last_on_level.values())
+    expect = sorted(i for i in kept if v[i] > max((v[q] for q in kept if q > i), default=0.0))
     assert rt[:n].tolist() == [float(i) for i in expect]
     np.testing.assert_array_equal(ry[:n], np.log(v[expect]))
+    if below == 3:  # the lowest level's point, the last sample, is left out
+        assert expect[-1] < v.size - 1
 
 
 def test_map_gamma_is_the_largest_product_on_the_envelope():

@@ -142,14 +142,16 @@ def ladder_clear(lt, j):
 
 
 @njit(cache=True, _nrt=False)
-def records(lt, lv, j, rt, ry):
+def records(lt, lv, j, rt, ry, lowest=0):
     """The right-envelope points of ladder row ``j``, in time order, into ``rt`` (times)
     and ``ry`` (log norms); returns their number.  The last sample on a level lies on the
-    envelope exactly when no higher level was visited later."""
+    envelope exactly when no higher level was visited later.  ``lowest``: no level below
+    it was visited (the scan stops there: an unvisited level is never a point, and a
+    decayed member's levels take up half of the ladder or less)."""
     n = 0
     latest = -1.0
     normal = True  # every norm positive, finite and normal
-    for b in range(NBINS - 1, -1, -1):
+    for b in range(NBINS - 1, max(lowest, 0) - 1, -1):
         t = lt[j, b]
         if t > latest:
             latest = t

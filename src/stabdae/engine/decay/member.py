@@ -8,7 +8,7 @@ import math
 from numba import njit
 
 from .fit import MIN_DECADES, STILL_DECAYING, estimate, grows, refit
-from .ladder import ladder_base, ladder_clear, ladder_level, records
+from .ladder import NBINS, ladder_base, ladder_clear, ladder_level, records
 from .onestep import map_estimate
 from .record import (
     C_BETA,
@@ -115,14 +115,14 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
     # before it
     drift = meas[row, C_D4] * 10.0**MIN_DECADES <= meas[row, C_INITIAL]
     if grows(meas[row, C_D2], meas[row, C_D3], meas[row, C_D4]) and not drift:
-        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
+        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest)
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
                          lowest, gen_h, floor_min)  # fmt: skip
     elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
                           lowest, gen_h, floor_min):  # fmt: skip
         if envelope:
-            fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
+            fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest)
         else:
             codes[row, I_POINTS] = 0
             codes[row, I_KIND] = K_NONE
@@ -130,10 +130,11 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
 
 
 @njit(cache=True, _nrt=False)
-def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg):
+def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest=0):
     """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
-    ``still``: the run ended while it was decaying)."""
-    n = records(lt, lv, j, rt, ry)
+    ``still``: the run ended while it was decaying; ``lowest``: no level below it was
+    visited)."""
+    n = records(lt, lv, j, rt, ry, lowest)
     estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row], codes[row])
 
 
@@ -190,6 +191,7 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b
     base[j] = ladder_base(nrm)
     t_hi = out[C_FIT_END]
     last = min(nsteps, int(math.ceil(t_hi / h - 1e-9)) + 1)
+    lowest = NBINS  # the lowest level written
     for k in range(last + 1):
         if k > 0:
             nrm = 0.0
@@ -205,6 +207,7 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b
             lev = ladder_level(nrm, base[j])
             lt[j, lev] = k * h
             lv[j, lev] = nrm
-    n = records(lt, lv, j, rt, ry)
+            lowest = min(lowest, lev)
+    n = records(lt, lv, j, rt, ry, lowest)
     out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, codes[row, I_KIND], h, a, b, lg,
                              out[C_SHIFT])  # fmt: skip
