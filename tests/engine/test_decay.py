@@ -471,3 +471,47 @@ def test_generator_fit_gives_the_rate_of_an_exact_flow(case):
         G.append(expm(h * A) @ G[-1])
     got = _generator_rate(A, np.array(G), steps, pm)
     assert abs(got - beta) <= fastest * 0.3**4 / 720, (got, beta)
+
+
+def test_pooled_end_is_the_general_one_and_refuses_other_sums():
+    """The fixed-step kernel ends a pooled law's members with
+    :func:`decay.map_estimate_pooled`, compiled without reference counting: on pooled sums
+    of exact pairs ``g_{k+1} = R g_k`` it writes what :func:`decay.map_estimate` writes,
+    bit for bit (β = −ln ρ(R)/τ); given a full map's sums or a generator's, which it
+    cannot fit, it raises instead of giving a rate."""
+    R = np.array([[0.95, 0.01], [-0.4, 0.9]])
+    rng = np.random.default_rng(3)
+    p = rng.standard_normal((2, 40))
+    q = R @ p
+    sums = [p[0] @ p[0], p[0] @ p[1], p[0] @ p[1], p[1] @ p[1], q[0] @ p[0], q[0] @ p[1],
+            q[1] @ p[0], q[1] @ p[1], 0.0, 0.0, 40.0]  # fmt: skip
+    pooled = np.empty((1, decay.MAP_BINS, 11))
+    pooled[0, :] = sums
+    lt, lv, _ = decay.ladders(1)
+    decay.ladder_clear(lt, 0)
+    for b in range(300, 432):  # a decay over 16 octaves, 1/8 octave per 0.01
+        lt[0, b] = (431 - b) * 0.01
+        lv[0, b] = 2.0 ** ((b - 431) / 8)
+    ref = decay.reference_logs(R)
+    tau = 1e-3
+
+    def run(fn, S, pm, gen_h=0.0):
+        meas = np.full((1, decay.NCOLS), np.nan)
+        meas[0, decay.C_D2:decay.C_D4 + 1] = 0.0
+        codes = np.zeros((1, decay.NCODES), np.int64)
+        rt, ry = np.empty(decay.NBINS), np.empty(decay.NBINS)
+        ok = fn(S, 0, 2, pm, lt, lv, 0, meas, codes, 0, tau, rt, ry, ref, 0, gen_h)
+        return ok, meas, codes
+
+    general, variant = run(decay.map_estimate, pooled, 1), run(decay.map_estimate_pooled, pooled, 1)
+    assert general[0] and variant[0]
+    np.testing.assert_array_equal(variant[1], general[1])
+    np.testing.assert_array_equal(variant[2], general[2])
+    rho = np.abs(np.linalg.eigvals(R)).max()
+    assert abs(general[1][0, decay.C_BETA] / (-math.log(rho) / tau) - 1) < 1e-9
+    full = np.zeros((1, decay.MAP_BINS, 2 * 2 * 2 + 1))
+    assert not run(decay.map_estimate, full, -1)[0]  # (no pairs: no rate)
+    with pytest.raises(AssertionError, match="full one-step map"):
+        run(decay.map_estimate_pooled, full, -1)
+    with pytest.raises(AssertionError, match="generator"):
+        run(decay.map_estimate_pooled, pooled, 1, gen_h=tau)

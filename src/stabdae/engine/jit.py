@@ -12,6 +12,7 @@ from __future__ import annotations
 import inspect
 import threading
 import time
+import types
 
 from numba import _dynfunc, config, njit
 from numba.core import event
@@ -20,7 +21,8 @@ from numba.core.compiler import Flags
 from numba.core.dispatcher import Dispatcher, _FunctionCompiler
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["JIT", "compile_seconds", "from_python", "internal", "is_njit", "python_function"]
+__all__ = ["JIT", "compile_seconds", "from_python", "internal", "is_njit", "python_function",
+           "variant"]
 
 #: False when numba's JIT is switched off (``NUMBA_DISABLE_JIT=1``)
 JIT = not config.DISABLE_JIT
@@ -41,6 +43,25 @@ def is_njit(fn) -> bool:
 def python_function(fn):
     """The Python function behind a dispatcher (the function itself without the JIT)."""
     return getattr(fn, "py_func", fn)
+
+
+def variant(fn, name: str, **replace):
+    """A copy of the Python function behind ``fn`` named ``name``, in which the global
+    names of ``replace`` refer to the objects given: the same source compiled on its own,
+    with other options or other callees (numba types a function's callees with the
+    caller's options, so a function compiled without reference counting cannot call one
+    that allocates; its variant can call a variant that does not).  Cached under its own
+    name (numba's cache files are named after the function).  The copy's globals are
+    those of ``fn``'s module when it is made: make it at the module's end."""
+    py = python_function(fn)
+    scope = dict(py.__globals__)
+    scope.update(replace)
+    copy = types.FunctionType(py.__code__, scope, name, py.__defaults__, py.__closure__)
+    copy.__qualname__ = name
+    copy.__module__ = py.__module__
+    copy.__doc__ = py.__doc__
+    copy.__kwdefaults__ = py.__kwdefaults__
+    return copy
 
 
 def internal(**options):

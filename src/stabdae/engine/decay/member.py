@@ -7,9 +7,10 @@ import math
 
 from numba import njit
 
+from ..jit import variant
 from .fit import MIN_DECADES, STILL_DECAYING, estimate, grows, refit
 from .ladder import NBINS, ladder_base, ladder_clear, ladder_level, records
-from .onestep import map_estimate
+from .onestep import map_estimate, map_estimate_pooled
 from .record import (
     C_BETA,
     C_BETA_PRED,
@@ -211,3 +212,9 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b
     n = records(lt, lv, j, rt, ry, lowest)
     out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, codes[row, I_KIND], h, a, b, lg,
                              out[C_SHIFT])  # fmt: skip
+
+
+#: :func:`finish_with_map` for the pooled one-step map of fixed steps, compiled without
+#: reference counting (:func:`.onestep.map_estimate_pooled`)
+finish_with_map_pooled = njit(cache=True, _nrt=False)(
+    variant(finish_with_map, "finish_with_map_pooled", map_estimate=map_estimate_pooled))

@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit
 
 from ..fma import fma
-from ..jit import internal
+from ..jit import internal, variant
 from ..workspace import stack1
 from .fit import FLOOR_MARGIN, MIN_DECADES, MIN_POINTS
 from .ladder import (
@@ -1028,3 +1028,36 @@ def _generator_radius(S, j, ng, pm, first, ref, h):
     if pairs < 2.0 * ng:
         return math.nan, pairs
     return _generator_full(s, ng, ref, h), pairs
+
+
+# --------------------------------------------------------------------- pooled ends
+# The fixed-step kernel of a law whose map is pooled (``pm ≥ 0``, no generator) ends its
+# members with variants of :func:`map_estimate` and :func:`.member.finish_with_map`
+# compiled without reference counting: the full map's and the generator's radii, which
+# allocate, are out of their reach (in their place, functions that raise).  The
+# reference-counted functions took and dropped a reference to each of their array
+# arguments at every member's end.
+
+
+@njit(cache=True, _nrt=False)
+def _full_radius_unavailable(S, j, ng, first, ref):
+    # (raised behind a test numba cannot fold, so that the function has a return type)
+    if j >= 0:
+        raise AssertionError("map_estimate_pooled: a full one-step map (pm < 0) needs "
+                             "map_estimate")  # fmt: skip
+    return math.nan, 0.0
+
+
+@njit(cache=True, _nrt=False)
+def _generator_radius_unavailable(S, j, ng, pm, first, ref, h):
+    if j >= 0:  # (as above)
+        raise AssertionError("map_estimate_pooled: a generator's sums (gen_h > 0) need "
+                             "map_estimate")  # fmt: skip
+    return math.nan, 0.0
+
+
+map_estimate_pooled = njit(cache=True, _nrt=False)(
+    variant(map_estimate, "map_estimate_pooled", _map_radius=_full_radius_unavailable,
+            _generator_radius=_generator_radius_unavailable))  # fmt: skip
+map_estimate_pooled.__doc__ = """:func:`map_estimate` for the pooled map of fixed steps
+(``pm ≥ 0``, ``gen_h = 0``), compiled without reference counting; other sums raise."""

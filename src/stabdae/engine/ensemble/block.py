@@ -81,6 +81,7 @@ from ..decay import (
     block_levels,
     difference_norms,
     finish_with_map,
+    finish_with_map_pooled,
     flushes_for,
     full_rows,
     ladder_base,
@@ -316,6 +317,8 @@ def build_block_kernel(K, spec: Spec):
     pairs_full = pairs_full_for(B, FULL)
     bin_flush, end_flush = flushes_for(FULL if pooled < 0 else 0)
     NA = 10 if pooled >= 0 else ROWS_FULL  # rows of the current bin visit's sums
+    # (a pooled map's end without reference counting: .decay.onestep, 'pooled ends')
+    finish_member = finish_with_map_pooled if pooled >= 0 else finish_with_map
 
     @internal(error_model="numpy")
     def block_norms(X, t, p, gref, nrm, dnrm, G):
@@ -669,9 +672,9 @@ def build_block_kernel(K, spec: Spec):
                 e1[lo + j] = energy(tf, xs_h, p, ws_h)
                 # no level below the lowest bin measured or the final state's was visited
                 lowest = min(low[j] << MAP_SHIFT, ladder_level(dn_b[j], base[j]))
-                finish_with_map(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
-                                ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb,
-                                lg, ref)  # fmt: skip
+                finish_member(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
+                              ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb, lg,
+                              ref)  # fmt: skip
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
                             meas, mcodes, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p,
