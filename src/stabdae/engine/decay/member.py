@@ -97,11 +97,13 @@ def finish(lt, lv, meas, codes, j, row, final, stopped, dt, rt, ry, a, b, lg):
 
 @njit(cache=True)
 def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base_j, lowest, dt, rt,
-                    ry, a, b, lg, ref, gen_h=0.0, floor_min=0.0, envelope=True):  # fmt: skip
+                    ry, a, b, lg, ref, gen_h=0.0, floor_min=0.0, envelope=True,
+                    low_bin=0):  # fmt: skip
     """:func:`finish` for a member with one-step map sums ``S`` (:func:`map_estimate`,
     ``dt`` the time between the map's pairs; ``lowest`` a level below which ladder row
     ``j`` has no point; ``ref`` the law's spectrum, :func:`reference_logs`; ``gen_h > 0``:
-    ``S`` holds a generator's sums, and ``floor_min`` the least floor, :func:`map_estimate`):
+    ``S`` holds a generator's sums, and ``floor_min`` the least floor; ``low_bin`` the
+    bin whose sums those below it hold; :func:`map_estimate`):
     β from the map where it has one, else from the envelope (unless not ``envelope``:
     then none, with the reason ``no transient``).  A member whose largest norms grow
     (:func:`grows`) gets the map only when the envelope does not find it growing (it may
@@ -119,9 +121,9 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
         fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest)
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                         lowest, gen_h, floor_min)  # fmt: skip
+                         lowest, gen_h, floor_min, low_bin)  # fmt: skip
     elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                          lowest, gen_h, floor_min):  # fmt: skip
+                          lowest, gen_h, floor_min, low_bin):  # fmt: skip
         if envelope:
             fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest)
         else:

@@ -81,9 +81,10 @@ def map_buffers(rows, ng, pm):
     a member that moved its sums at every change of bin did so at every few measured
     states, about a fifth of the measurement's cost on the pendulum.)
 
-    Not cleared: every bin a member's end may read is written for that member, by its
+    Not cleared: every bin a member's end reads is written for that member, by its
     start (:func:`map_begin`, those above its initial bin), its falls
-    (:func:`bin_flush`) or its end (:func:`end_flush`).  (Zeroed, they were 180 kB
+    (:func:`bin_flush`) or its end (:func:`end_flush`, the lowest bin it reached, from
+    which the end reads the bins below it).  (Zeroed, they were 180 kB
     written for a block of 64 pooled members at every call of the kernel on a chunk of
     blocks: 26 calls for 10⁴ members on two threads.)"""
     return np.empty((rows, MAP_BINS, map_width(ng, pm)))
@@ -106,8 +107,9 @@ def map_width(ng, pm):
 @njit(cache=True, _nrt=False)
 def map_begin(S, j, low):
     """Slot ``j``'s sums for a new member, whose initial level is in bin ``low``: those
-    of the bins above it cleared (no pair comes before a fall below them).  The others
-    are written before the member's end (:func:`bin_flush`, :func:`end_flush`)."""
+    of the bins above it cleared (no pair comes before a fall below them).  Those down
+    to the lowest it reaches are written before the member's end (:func:`bin_flush`,
+    :func:`end_flush`); the end reads the bins below that one from it."""
     for b in range(low + 1, S.shape[1]):
         for c in range(S.shape[2]):
             S[j, b, c] = 0.0
@@ -132,7 +134,8 @@ def full_rows(ng: int) -> int:
 #   for the first time (``bin_flush``: a scalar loop over the members whose bit is set in
 #   the mask ``block_levels`` returns; a member crosses each bin once, where a flush at
 #   every change of bin came at every few measured states of a residual on its floor), and
-#   at the end for the bins it never went below (``end_flush``);
+#   at the end for the lowest bin it reached (``end_flush``: the bins below hold the same
+#   sums, read from that one);
 # * the largest norms of the current fifth of the run in ``wmax`` and ``dmax``, written to
 #   the member's row when the fifth ends or the member stops (``windows_flush``).
 #
@@ -265,12 +268,13 @@ def bin_flush(S, A, nlev, low, mask, pooled, full):
 
 @njit(cache=True, error_model="numpy")
 def end_flush(S, A, low, active, pooled, full):
-    """At the end of the run: each running slot's sums as those of the bins it did not go
-    below (all of them, zero, when no state was measured)."""
+    """At the end of the run: each running slot's sums as those of the lowest bin it
+    reached, ``low[j]`` (zero when no state was measured).  The bins below hold the same
+    sums and are not written: the member's end reads bin ``max(b, low[j])`` for bin ``b``
+    (:func:`map_estimate`'s ``low_bin``)."""
     for j in range(low.shape[0]):
         if active[j]:
-            for b in range(low[j] + 1):
-                _store(S, A, j, b, pooled, full)
+            _store(S, A, j, low[j], pooled, full)
 
 
 @njit(cache=True, error_model="numpy")
@@ -368,8 +372,7 @@ def flushes_for(FULL: int):
     def end_flush_full(S, A, low, active, pooled, full):
         for j in range(low.shape[0]):
             if active[j]:
-                for b in range(low[j] + 1):
-                    _store_full(S, A, j, b)
+                _store_full(S, A, j, low[j])
 
     return bin_flush_full, end_flush_full
 
@@ -750,7 +753,7 @@ def _map_gamma(lt, lv, j, lo, top, beta, w):
 
 @njit(cache=True)
 def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref,
-                 lowest=0, gen_h=0.0, floor_min=0.0):  # fmt: skip
+                 lowest=0, gen_h=0.0, floor_min=0.0, low_bin=0):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
@@ -770,7 +773,9 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
     on the scale of a step ``gen_h`` (``ref``'s); ``β = −max Re λ(Â)``.  ``floor_min``:
     the least floor the cut is taken from (an adaptive member's distance from the
     reference has a floor of its own, the local errors of steps that fall apart from the
-    reference's, which its last fifth may not show).  Returns whether it gave β."""
+    reference's, which its last fifth may not show).  ``low_bin``: the lowest bin the
+    member's level went below, whose sums are those of every bin below it too (read from
+    it: :func:`end_flush`).  Returns whether it gave β."""
     if S.shape[2] == 0:
         return False
     floor = max(meas[row, C_D4], floor_min)
@@ -796,14 +801,15 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
         if top - cut < per_decade:
             continue
         first = (cut + (1 << MAP_SHIFT) - 1) >> MAP_SHIFT  # bins wholly above the cut
+        read = max(first, low_bin)  # (the bins below low_bin hold its sums)
         if gen_h > 0.0:
-            rho, pairs = _generator_radius(S, j, ng, pm, first, ref, gen_h)
+            rho, pairs = _generator_radius(S, j, ng, pm, read, ref, gen_h)
             # too few steps above this cut: a lower one has more
             if pairs < MIN_POINTS:
                 continue
         else:
-            rho, pairs = (_pooled_radius(S, j, first, ref) if pm >= 0
-                          else _map_radius(S, j, ng, first, ref))  # fmt: skip
+            rho, pairs = (_pooled_radius(S, j, read, ref) if pm >= 0
+                          else _map_radius(S, j, ng, read, ref))  # fmt: skip
         if not (rho < 1.0 and rho > 0.0):
             return False
         beta = -math.log(rho) / (gen_h if gen_h > 0.0 else tau)

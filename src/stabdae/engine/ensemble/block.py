@@ -658,7 +658,7 @@ def build_block_kernel(K, spec: Spec):
                 for l in range(ng):
                     g_out[nsteps, l] = Gb[l, 0]
             windows_flush(meas, wmax, dmax, window, active, lo, cnt)
-            # the sums of the bins not gone below (map_begin cleared only those above)
+            # the sums of the lowest bin reached (those below it are read from it)
             end_flush(S_map, Am, low, active, pooled_, full_)
             for j in range(cnt):
                 final = math.nan
@@ -674,7 +674,7 @@ def build_block_kernel(K, spec: Spec):
                 lowest = min(low[j] << MAP_SHIFT, ladder_level(dn_b[j], base[j]))
                 finish_member(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
                               ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb, lg,
-                              ref)  # fmt: skip
+                              ref, 0.0, 0.0, True, low[j])  # fmt: skip
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
                             meas, mcodes, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p,
