@@ -70,8 +70,13 @@ TAU, T_END, SAVE_DT = 1e-3, 10.0, 0.05
 NSTEPS, SAVE_EVERY = round(T_END / TAU), round(SAVE_DT / TAU)
 #: the members' ends as in the timed runs: read from runs of this many steps and twice
 #: as many (2 s and 4 s: the same members measured by their one-step maps in both, about
-#: a quarter; the others' distance from the reference rises above their transient)
+#: a quarter.  The members are given as ``x0``, so each is measured on its raw residual,
+#: whose floor is the midpoint rule's along the motion, about 7e-6: those that start
+#: less than about 2.5 decades above it have no transient to fit)
 MAP_ENDS_STEPS = 2000
+#: best of at least this many runs for each of the two runs the ends are read from (their
+#: difference is a small number from two larger ones)
+ENDS_REPEAT = 9
 
 
 def build_c(*extra: str) -> ctypes.CDLL:
@@ -144,10 +149,12 @@ def one_thread(model, law, x0, divergence, lib, repeat):
 def member_ends(model, law, x0, divergence, repeat, short=SAVE_EVERY):
     """Core time per member of what the kernel does once per member (placing it in a
     slot, its decay fit, the map's radius, γ, its outputs), in µs: the intercept at zero
-    steps of the kernel's time over ``short`` and ``2 short`` steps (best of ``repeat``
-    each), times the threads.  Over 50 and 100 steps (0.1 s) few members' residuals have
-    fallen a decade: nearly all go through the envelope's fit; over ``MAP_ENDS_STEPS`` and
-    twice as many, the members are measured as in the runs timed."""
+    steps of the kernel's time over ``short`` and ``2 short`` steps (best of ``repeat``,
+    at least ``ENDS_REPEAT``, each), times the threads.  Over 50 and 100 steps (0.1 s) few
+    members' residuals have fallen a decade: nearly all go through the envelope's fit;
+    over ``MAP_ENDS_STEPS`` and twice as many, the members are measured as in the runs
+    timed."""
+    repeat = max(repeat, ENDS_REPEAT)
     t1 = min(run_kernel(model, law, x0, divergence, short)[0] for _ in range(repeat))
     t2 = min(run_kernel(model, law, x0, divergence, 2 * short)[0] for _ in range(repeat))
     return (2.0 * t1 - t2) * numba.get_num_threads() / x0.shape[0] * 1e6

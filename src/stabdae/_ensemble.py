@@ -243,7 +243,10 @@ def ensemble(
         ``i``'s is a function of the seed and ``i`` alone (a counter-based generator), so
         the first ``k`` members of any ensemble with this seed are the same.
     x0 : array (members, 2n), optional
-        The user's own initial states instead of sampled ones.
+        The user's own initial states instead of sampled ones.  Their decay is measured
+        on their raw residual norm (there is no reference trajectory to measure their
+        distance from: they need not lie near the model's reference state), whose floor
+        is set by the scheme's local errors along each one's motion.
     params : mapping or array, optional
         Physical parameters.
     epsilon : float, optional
