@@ -146,8 +146,7 @@ def records(lt, lv, j, rt, ry, lowest=0):
     """The right-envelope points of ladder row ``j``, in time order, into ``rt`` (times)
     and ``ry`` (log norms); returns their number.  The last sample on a level lies on the
     envelope exactly when no higher level was visited later.  ``lowest``: no level below
-    it was visited (the scan stops there: an unvisited level is never a point, and a
-    decayed member's levels take up half of the ladder or less)."""
+    it was visited (the scan stops there: an unvisited level is never a point)."""
     n = 0
     latest = -1.0
     normal = True  # every norm positive, finite and normal

@@ -84,9 +84,9 @@ def map_buffers(rows, ng, pm):
     Not cleared: every bin a member's end reads is written for that member, by its
     start (:func:`map_begin`, those above its initial bin), its falls
     (:func:`bin_flush`) or its end (:func:`end_flush`, the lowest bin it reached, from
-    which the end reads the bins below it).  (Zeroed, they were 180 kB
-    written for a block of 64 pooled members at every call of the kernel on a chunk of
-    blocks: 26 calls for 10⁴ members on two threads.)"""
+    which the end reads the bins below it).  (Zeroed, they were 180 kB written for a
+    block of 64 pooled members at every call of the kernel on a chunk of blocks: 26 calls
+    for 10⁴ members on two threads.)"""
     return np.empty((rows, MAP_BINS, map_width(ng, pm)))
 
 

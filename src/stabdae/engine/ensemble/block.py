@@ -674,7 +674,7 @@ def build_block_kernel(K, spec: Spec):
                 lowest = min(low[j] << MAP_SHIFT, ladder_level(dn_b[j], base[j]))
                 finish_member(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
                               ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb, lg,
-                              ref, 0.0, 0.0, True, low[j])  # fmt: skip
+                              ref, low_bin=low[j])  # fmt: skip
                 if R.shape[0] > 0:
                     predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
                             meas, mcodes, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p,
