@@ -894,8 +894,12 @@ def _trace_rows(traces, members: int, who: str, first: bool = False):
     if first:
         traced = np.arange(count, dtype=np.int64)
     else:
-        traced = np.unique(np.linspace(0, members - 1, count).round().astype(np.int64)) \
-            if count else np.zeros(0, dtype=np.int64)  # fmt: skip
+        # evenly spaced and rounded: non-decreasing, so the distinct ones are those unlike
+        # the one before (np.unique's sort took 1 ms for 10⁴ members traced)
+        traced = np.linspace(0, members - 1, count).round().astype(np.int64)
+        distinct = np.ones(traced.size, dtype=bool)
+        distinct[1:] = traced[1:] != traced[:-1]
+        traced = traced[distinct]
     trace_row = np.full(members, -1, dtype=np.int64)
     trace_row[traced] = np.arange(traced.size)
     return trace_row, traced

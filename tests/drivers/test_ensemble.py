@@ -371,6 +371,23 @@ def test_members_stopped_mid_run_keep_their_last_good_state():
                                            full.residual_norm.values[:-1].max(), rtol=1e-12)
 
 
+@pytest.mark.parametrize("members", [1, 2, 7, 40, 10_000])
+def test_traced_members_are_evenly_spaced_and_distinct(members):
+    """The traced members for each count (none, one, a few, all but one, all, more than
+    all): the rounded points of ``linspace(0, members − 1, count)``, each once (NumPy's
+    ``unique`` of them), and each trace row the member's place among them."""
+    from stabdae._ensemble import _trace_rows
+
+    for traces in (0, 1, 2, 3, members - 1, members, members + 5, "all", "none"):
+        count = min({"all": members, "none": 0}.get(traces, traces), members)
+        row, traced = _trace_rows(traces, members, "ensemble")
+        expect = np.unique(np.linspace(0, members - 1, count).round().astype(np.int64))
+        np.testing.assert_array_equal(traced, expect)
+        assert traced.dtype == np.int64
+        np.testing.assert_array_equal(row[traced], np.arange(traced.size))
+        assert (np.delete(row, traced) == -1).all()
+
+
 def test_traces_and_states_are_optional_and_change_no_measurement():
     """traces='none', a number, 'all', and states=False: the same β, classes and
     summaries; the stored traces are those of the named members; the measurements are
