@@ -91,6 +91,25 @@ def test_pivot_rule_is_relative_to_the_matrix_scale(scale):
     assert ldl_inplace(near.copy(), 2, 1e-12) == 2
 
 
+@pytest.mark.parametrize("rtol", [0.0, 1e-14, 1e-12, 0.5])
+def test_written_out_pivot_of_size_one_fails_as_the_loop(rtol):
+    """Of size 1 the written-out factor tests its pivot without the abs: it must fail the
+    same pivots as the loops (d ≤ 0, ±inf, NaN, the signed zeros) and pass the same, the
+    subnormal ones included, and store the same reciprocal."""
+    from stabdae.engine.linalg import ldl_factor_for
+
+    tiny = np.finfo(float).smallest_subnormal
+    pivots = [np.nan, np.inf, -np.inf, 0.0, -0.0, -1.0, -tiny, tiny, 1e-300, 1.0, 1e300,
+              np.finfo(float).max]  # fmt: skip
+    for d in pivots:
+        loops, out = np.full((2, 2), d), np.full((2, 2), d)
+        code_loop = ldl_inplace(loops, 1, rtol)
+        assert ldl_factor_for(1)(out, 1, rtol) == code_loop, d
+        assert code_loop == (not 0.0 < d < np.inf), d
+        assert np.array_equal(out, loops, equal_nan=True), d
+
+
+
 @pytest.mark.parametrize("n", [1, 2, 3, 4, 8])  # each size is a compilation
 def test_written_out_and_looped_ldl_agree_bit_for_bit(n):
     """The straight-line factor and solves that a dense right-hand side uses for its sizes
