@@ -343,12 +343,12 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
         with walls("sample"):
             x0, alpha0, status, g_ref = placed = _members(run, x0)
         with walls("integrate"):
-            out = run.mode.integrate(run, x0, alpha0, status, g_ref)
+            out, band = _integrate(run, x0, alpha0, status, g_ref)
     except Exception as exc:  # a model function raised: say which, when and where
         raise _raised_in(run, "ensemble", exc, None if placed is None else x0) from exc
     status = np.where(status != 0, status, out.status).astype(np.int8)
     with walls("dataset"):
-        referee = _referee(run, g_ref)
+        referee = _referee(run, g_ref, band)
         roundoff = _roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
                              run.threads, run.sampled)  # fmt: skip
         table = _build(run, times, x0, alpha0, out, status, referee, peak, roundoff)
@@ -835,13 +835,45 @@ def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK,
     return out.g_out
 
 
-def _referee(run: _RunSpec, g_ref) -> dict:
+def _integrate(run: _RunSpec, x0, alpha0, status, g_ref):
+    """``(out, band)``: the members' outputs, and the floor band :func:`_reference_floor`
+    would give where the verdicts are judged against it (no reference residuals to read
+    it from; fixed steps), read from the reference state run as one more member of the
+    same kernel call: members never interact, so its numbers are those of its run alone,
+    without that run's own pass over a whole block of slots.  ``band`` is None otherwise,
+    and where that member stopped (then its run alone, without the divergence
+    threshold, gives the band as before)."""
+    if run.adaptive or (g_ref is not None and g_ref.shape[0] > 1):
+        return run.mode.integrate(run, x0, alpha0, status, g_ref), None
+    M, ng = x0.shape[0], run.model.n_residual
+    ref = np.asarray(run.model.reference_state(run.p), dtype=float)[None, :]
+    progress = run.progress
+    more = replace(run, trace_row=np.append(run.trace_row, -1),
+                   progress=None if progress is None
+                   else lambda done, _: progress(min(done, M), M))  # fmt: skip
+    out = run.mode.integrate(more, np.concatenate([x0, ref]),
+                             np.concatenate([alpha0, np.zeros((1, ng))]),
+                             np.append(status, np.int8(0)), g_ref)  # fmt: skip
+    band = None
+    if out.status[M] == 0:
+        rec = Record(out.meas[M:], out.codes[M:])
+        band = np.array([rec[f"w{w}"][0] for w in range(5)], dtype=float)
+        if not np.isfinite(band).all():
+            band = np.zeros(5)  # as :func:`_reference_floor` gives it
+    per_member = ("meas", "codes", "x_final", "status", "fail_step", "e0", "e1")
+    return out._replace(**{name: getattr(out, name)[:M] for name in per_member}), band
+
+
+def _referee(run: _RunSpec, g_ref, band=None) -> dict:
     """What a member's verdict is judged against (:func:`._measures.verdict`): the
     reference trajectory's largest residual per fifth of the run (its truncation floor:
     from its stored residuals, or from a run of the mode's kernel on the reference state
-    alone), and, where ``Ã`` is constant, ``ρ`` of the one-step propagator and
-    ``sup ‖R^k‖∞`` per fifth (:func:`.theory.fifth_bounds`)."""
-    if g_ref is not None and g_ref.shape[0] > 1:
+    alone, or ``band`` where that run was read from the members' own, :func:`_integrate`),
+    and, where ``Ã`` is constant, ``ρ`` of the one-step propagator and ``sup ‖R^k‖∞`` per
+    fifth (:func:`.theory.fifth_bounds`)."""
+    if band is not None:
+        pass
+    elif g_ref is not None and g_ref.shape[0] > 1:
         if run.adaptive:  # rows (t, g) at the reference's accepted steps, fifths by time
             t = g_ref[:, 0]
             fifth = np.minimum(4, (5.0 * (t - run.t0) / (run.t_end - run.t0)).astype(int))

@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -369,6 +370,41 @@ def test_members_stopped_mid_run_keep_their_last_good_state():
             if status == stabdae.Status.DIVERGED:  # (the last state is the one not measured)
                 np.testing.assert_allclose(ds.max_residual.values[j],
                                            full.residual_norm.values[:-1].max(), rtol=1e-12)
+
+
+@pytest.mark.parametrize(("members", "divergence"), [(64, None), (70, None), (20, 1e-30)])
+def test_reference_floor_read_beside_the_members_is_its_run_alone(members, divergence):
+    """An ensemble given ``x0`` has no reference residuals: its verdicts' floor band is
+    the reference state's own run, which runs as one more member of the members' kernel
+    call.  The band must be that of its run alone bit for bit, the members' outputs
+    those of their run without it, and progress must count the user's members only (64:
+    the extra member opens a block of its own).  Where that member stops (a divergence
+    threshold below every residual), the band comes from its run alone, without the
+    threshold, as before."""
+    from stabdae import _ensemble as E
+
+    model = load_scene("pendulum")
+    x0, _, _ = stabdae.sample_perturbations(model, members, (1e-6, 1e-2), seed=4)
+    seen = []
+    run = E._run_spec("ensemble", model, stabdae.baumgarte(10.0, 1.0), "midpoint", 1e-3, 0.5,
+                      None, None, members, (1e-6, 1e-2), 0, 0.05, x0, None, None, divergence,
+                      None, None, lambda done, total: seen.append((done, total)), "float32",
+                      3, True)  # fmt: skip
+    x0, alpha0, status, g_ref = E._members(run, x0)
+    assert g_ref.shape[0] == 0
+    out, band = E._integrate(run, x0, alpha0, status, g_ref)
+    alone = E._reference_floor(run)
+    if divergence is None:
+        assert band is not None and (band > 0).all()
+        np.testing.assert_array_equal(band, alone)
+    else:
+        assert band is None and (out.status != 0).all()
+    np.testing.assert_array_equal(E._referee(run, g_ref, band)["floor_band"], alone)
+    plain = run.mode.integrate(replace(run, progress=None), x0, alpha0, status, g_ref)
+    for name in plain._fields:
+        np.testing.assert_array_equal(getattr(out, name), getattr(plain, name), err_msg=name)
+    assert seen and all(total == members and done <= members for done, total in seen)
+    assert seen[-1][0] == members
 
 
 @pytest.mark.parametrize("members", [1, 2, 7, 40, 10_000])
