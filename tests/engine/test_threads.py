@@ -71,3 +71,35 @@ def test_chunks_shrink_towards_the_end(items, threads):
             assert hi - lo <= max(1, (items - lo) // (2 * threads))
     if threads > 1 and items > 2 * threads:
         assert chunks[-1][1] - chunks[-1][0] == 1
+
+
+def test_the_calling_thread_works_and_reports_and_a_workers_error_reaches_it():
+    """The calling thread takes chunks itself (a future per chunk cost about as much as a
+    small call's work) and is the only one to report progress; an error in a chunk a
+    worker runs stops the calling thread's chunks and is raised there, after every
+    running chunk has ended."""
+    caller = threading.get_ident()
+    ran_by, reporters, after = [], set(), []
+
+    def kernel(lo, hi):
+        if hi == 0:
+            return
+        ran_by.append(threading.get_ident())
+        if threading.get_ident() != caller:
+            raise RuntimeError(f"worker chunk {lo} failed")
+        time.sleep(0.02)  # the worker takes a chunk while the caller works on this one
+        after.append(lo)
+
+    with pytest.raises(RuntimeError, match="worker chunk"):
+        run_chunks(kernel, 40, threads=2, progress=lambda d, n: reporters.add(
+            threading.get_ident()))
+    assert caller in ran_by and any(t != caller for t in ran_by)
+    assert reporters <= {caller}
+    assert len(after) < 39  # the caller stopped before the chunks were all taken
+    ended = len(after)
+    time.sleep(0.05)
+    assert len(after) == ended
+    reports = []
+    run_chunks(lambda lo, hi: None, 10, threads=2, progress=lambda d, n: reports.append(
+        threading.get_ident()))
+    assert set(reports) == {caller}

@@ -10,6 +10,7 @@ the thread count or on which thread ran which chunk.
 
 from __future__ import annotations
 
+import itertools
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor, wait
@@ -65,21 +66,50 @@ def run_chunks(kernel, items: int, *, threads: int | None = None, progress=None,
                     progress(done, items)
             return
         kernel(0, 0)
-        pool = _pool(threads)
-        futures = [(hi - lo, pool.submit(kernel, lo, hi)) for lo, hi in chunks]
-        try:
-            for size, fut in futures:
-                fut.result()
-                done += size
-                if progress is not None:
-                    progress(done, items)
-        except BaseException:
-            for _, fut in futures:
-                fut.cancel()
-            for _, fut in futures:  # nothing of this call runs on after it has returned
-                if not fut.cancelled():
-                    wait([fut])
-            raise
+        _run_shared(kernel, chunks, threads, progress, items)
+
+
+def _run_shared(kernel, chunks, threads: int, progress, items: int) -> None:
+    """The chunks taken in turn by the calling thread and ``threads − 1`` workers of the
+    pool, each taking the next chunk not yet taken when it is free (the calling thread
+    works too: a future per chunk, each handed to the pool and waited for, cost about
+    as much as a small call's work).  ``progress`` is called from the calling thread
+    after each chunk it runs and once at the end.  A chunk that raises, or an interrupt
+    of the calling thread, stops every thread before its next chunk; the chunks running
+    end before this returns, and the first error is raised."""
+    taken = itertools.count()  # ``next`` is atomic: each chunk is taken once
+    lock = threading.Lock()
+    state = {"done": 0, "stop": False}
+
+    def work(report):
+        while not state["stop"]:
+            i = next(taken)
+            if i >= len(chunks):
+                return
+            lo, hi = chunks[i]
+            try:
+                kernel(lo, hi)
+            except BaseException:
+                state["stop"] = True
+                raise
+            with lock:
+                state["done"] += hi - lo
+                done = state["done"]
+            if report is not None:
+                report(done, items)
+
+    pool = _pool(threads - 1)
+    helpers = [pool.submit(work, None) for _ in range(threads - 1)]
+    try:
+        work(progress)
+        for fut in helpers:
+            fut.result()
+    except BaseException:
+        state["stop"] = True
+        wait(helpers)  # nothing of this call runs on after it has returned
+        raise
+    if progress is not None:
+        progress(items, items)
 
 
 _POOLS: dict[int, ThreadPoolExecutor] = {}
