@@ -93,9 +93,10 @@ def test_pivot_rule_is_relative_to_the_matrix_scale(scale):
 
 @pytest.mark.parametrize("rtol", [0.0, 1e-14, 1e-12, 0.5])
 def test_written_out_pivot_of_size_one_fails_as_the_loop(rtol):
-    """Of size 1 the written-out factor tests its pivot without the abs: it must fail the
-    same pivots as the loops (d ≤ 0, ±inf, NaN, the signed zeros) and pass the same, the
-    subnormal ones included, and store the same reciprocal."""
+    """Of size 1 the written-out factor tests its pivot as ``min(d, 1/d) > 0``, with no
+    product by the tolerance: for tolerances up to 1/2 it must fail the same pivots as
+    the loops (d ≤ 0, ±inf, NaN, the signed zeros) and pass the same, the subnormal ones
+    included, and store the same reciprocal."""
     from stabdae.engine.linalg import ldl_factor_for
 
     tiny = np.finfo(float).smallest_subnormal
