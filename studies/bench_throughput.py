@@ -15,7 +15,9 @@ Baumgarte ω = 10, ξ = 1, τ = 1e-3, 10 s (10⁴ steps), residual norm stored e
   vectorized by gcc), both OpenMP-parallel (``studies/bench_c/pendulum_rk2.c``); the blocked
   form also with ``-ffp-contract=off`` (no fused multiply-adds at all; gcc's default fuses
   wherever it likes, stabdae fuses its own multiply-adds explicitly, not the user's
-  expressions, see ``stabdae.engine.fma``);
+  expressions, see ``stabdae.engine.fma``), and with the failure test stabdae's step
+  makes (``run_blocked_checked``: each stage's pivot ``S > 1e-12 |S|``, ORed per member;
+  the ratios are given to the blocked C without it);
 * NumPy vectorized over members;
 * JAX ``lax.scan`` + ``vmap`` when jax is installed.
 
@@ -91,6 +93,8 @@ def build_c(*extra: str) -> ctypes.CDLL:
     for name in ("run_scalar", "run_blocked"):
         getattr(lib, name).argtypes = argtypes
         getattr(lib, name).restype = None
+    lib.run_blocked_checked.argtypes = [*argtypes, ctypes.c_void_p]
+    lib.run_blocked_checked.restype = None
     lib.set_threads.argtypes = [ctypes.c_int]
     lib.set_threads.restype = None
     return lib
@@ -104,6 +108,20 @@ def run_c(fn, x0):
     fn(M, x0.ctypes.data, G, L, A0, A1, TAU, NSTEPS, SAVE_EVERY, norms.ctypes.data,
        xf.ctypes.data)  # fmt: skip
     return time.perf_counter() - start, xf
+
+
+def run_c_checked(lib, x0):
+    """The blocked C with the failure test of stabdae's step (each stage's pivot tested,
+    ``run_blocked_checked``): seconds, final states, and whether any member's test
+    failed."""
+    M = x0.shape[0]
+    norms = np.empty((M, NSTEPS // SAVE_EVERY + 1), dtype=np.float32)
+    xf = np.empty_like(x0)
+    failed = np.empty(M, dtype=np.uint8)
+    start = time.perf_counter()
+    lib.run_blocked_checked(M, x0.ctypes.data, G, L, A0, A1, TAU, NSTEPS, SAVE_EVERY,
+                            norms.ctypes.data, xf.ctypes.data, failed.ctypes.data)
+    return time.perf_counter() - start, xf, bool(failed.any())
 
 
 def run_kernel(model, law, x0, divergence, nsteps, measure=True):
@@ -292,6 +310,7 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
         x0, _, _ = stabdae.sample_perturbations(model, M, (1e-6, 1e-2), seed=1)
         steps = M * NSTEPS
         api = api_all = kernel = step_only = half = t_blocked = t_ieee = t_base = np.inf
+        t_checked = np.inf
         for _ in range(max(1, args.repeat)):  # in turn, best of each
             start = time.perf_counter()
             ds = stabdae.ensemble(model, law, "midpoint", TAU, T_END, x0=x0, save_dt=SAVE_DT)
@@ -313,8 +332,11 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
             t, xf_blocked = run_c(lib.run_blocked, x0)
             t_blocked = min(t_blocked, t)
             t_ieee = min(t_ieee, run_c(lib_ieee.run_blocked, x0)[0])
+            t, xf_checked, failed = run_c_checked(lib, x0)
+            t_checked = min(t_checked, t)
         assert np.array_equal(xf_kernel, ds.x_final.values)
         assert np.array_equal(xf_step, xf_kernel)  # the measurement changes no state
+        assert np.array_equal(xf_checked, xf_blocked) and not failed  # the test changes none
         one_kernel, one_c = one_thread(model, law, x0, ds.attrs["divergence"], lib,
                                        max(1, args.repeat))  # fmt: skip
         ends = member_ends(model, law, x0, ds.attrs["divergence"], max(1, args.repeat))
@@ -330,7 +352,7 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
                "member_ends_core_us": ends, "member_ends_map_core_us": ends_map,
                "one_thread_kernel_step_only_s": one_kernel, "one_thread_c_blocked_s": one_c,
                "c_scalar_s": t_scalar, "c_blocked_s": t_blocked,
-               "c_blocked_no_fma_s": t_ieee,
+               "c_blocked_no_fma_s": t_ieee, "c_blocked_checked_s": t_checked,
                "max_diff_vs_c": float(np.max(np.abs(xs - xf_blocked)))}  # fmt: skip
         if baseline:
             row["baseline_api_s"] = t_base
@@ -354,7 +376,8 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
             variants.append((f"stabdae API at {baseline.rev[:10]}", t_base))
         variants += [("C, one member per iteration", t_scalar),
                      ("C, blocked + vectorized", t_blocked),
-                     ("C, blocked, -ffp-contract=off", t_ieee)]  # fmt: skip
+                     ("C, blocked, -ffp-contract=off", t_ieee),
+                     ("C, blocked, failures tested", t_checked)]  # fmt: skip
         if "numpy_s" in row:
             variants.append(("NumPy over members", row["numpy_s"]))
         if "jax_s" in row:
@@ -364,6 +387,9 @@ def _runs(args, model, law, lib, lib_ieee, baseline, report):
         print(f"one thread each: the kernel without the measurement {one_kernel:.3f} s, the "
               f"blocked C {one_c:.3f} s: {one_c / one_kernel:.3f} of the C (the C's time on "
               f"{numba.get_num_threads()} threads is {t_blocked / one_c:.2f} of its time on one)")
+        print(f"against the blocked C that tests each stage's pivot as stabdae's step "
+              f"does: the kernel without the measurement {t_checked / step_only:.3f}, its "
+              f"steps alone {t_checked / (2.0 * (step_only - half)):.3f}")
         print(f"each member's start and end in the kernel: {ends:.3f} µs of core time "
               f"(runs of {SAVE_EVERY} and {2 * SAVE_EVERY} steps), {ends_map:.3f} µs (runs "
               f"of {MAP_ENDS_STEPS} and {2 * MAP_ENDS_STEPS} steps; "
