@@ -674,9 +674,15 @@ def _build(model, spec: Spec) -> Kernels:
                     s = fma(law_mat[i, j], g[j], s)
                 rl[i] = s
         elif LAW == LAW_SCALAR_BLOCKS:
+            # −(c − a₀ f − a₁ ḟ): the same sums as a₁ ḟ + (a₀ f + (−c)), each rounded once
+            # and negated exactly (they differ only in the sign of a sum that cancels to
+            # zero exactly), with c left positive.  A user's c is often 2·(…), which LLVM
+            # then adds to itself instead of multiplying by −2, and the negation goes into
+            # the multiply-adds that follow: one product less per evaluation (the
+            # pendulum's ensemble stepped 4–5 % faster)
             for i in range(m):
-                s = fma(law_mat[0, 0], g[i], rl[i])
-                rl[i] = fma(law_mat[0, 1], g[m + i], s)
+                s = fma(-law_mat[0, 0], g[i], sm[i])
+                rl[i] = -fma(-law_mat[0, 1], g[m + i], s)
             for i in range(k):
                 rl[m + i] = fma(law_mat[0, 2], g[2 * m + i], rl[m + i])
         elif LAW == LAW_USER:
