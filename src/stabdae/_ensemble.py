@@ -777,7 +777,7 @@ def _members(run: _RunSpec, x0, reference: bool = True):
     none = np.zeros((0, model.n_residual))
     if x0 is not None:
         alpha0 = _residual_rows(model, x0, p, t0, run.threads)
-        status = np.where(np.isfinite(x0).all(axis=1), 0, int(Status.NONFINITE_STATE))
+        status = np.where(_measures.rows_finite(x0), 0, int(Status.NONFINITE_STATE))
         return x0, alpha0, status.astype(np.int8), none
     targets = draw_alphas(model.n_residual, run.members, (run.low, run.high), run.seed,
                           run.start)  # fmt: skip

@@ -99,7 +99,7 @@ def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, trace
         verdicts = _measures.verdict(meas, status, roundoff=roundoff, **(referee or {}))
     verdicts, why = verdicts
     cls = _measures.classify(meas, status, epsilon, verdicts)
-    alpha_norm = np.max(np.abs(alpha0), axis=1)
+    alpha_norm = _measures.row_max_abs(alpha0)
     summary, radius_why = _measures.summaries(meas, verdicts, why, cls, alpha_norm, epsilon)
     stable, bounded = _measures.flags(meas, verdicts, epsilon)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):

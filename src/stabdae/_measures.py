@@ -97,6 +97,34 @@ TRANSIENT_SLACK = 2.0
 _BLOWN_UP = (Status.DIVERGED, Status.NONFINITE_STATE, Status.SINGULAR_S, Status.MASS_NOT_SPD)
 
 
+def blown_up(status: np.ndarray) -> np.ndarray:
+    """Whether each member's status is one of a blow-up (``np.isin`` of the four codes,
+    compared one by one: ``np.isin``'s own work took 80 µs on 10⁴ members)."""
+    out = status == int(_BLOWN_UP[0])
+    for code in _BLOWN_UP[1:]:
+        out |= status == int(code)
+    return out
+
+
+def row_max_abs(a: np.ndarray) -> np.ndarray:
+    """``np.max(np.abs(a), axis=1)`` for a 2-D ``a`` of at least one column (NaN where a
+    row has one), column by column: over a few columns numpy's reduction along rows took
+    360 µs on 10⁴ rows of 2."""
+    out = np.abs(a[:, 0])
+    for c in range(1, a.shape[1]):
+        np.maximum(out, np.abs(a[:, c]), out=out)
+    return out
+
+
+def rows_finite(a: np.ndarray) -> np.ndarray:
+    """``np.isfinite(a).all(axis=1)`` for a 2-D ``a``, column by column (as
+    :func:`row_max_abs`)."""
+    out = np.ones(a.shape[0], dtype=bool)
+    for c in range(a.shape[1]):
+        out &= np.isfinite(a[:, c])
+    return out
+
+
 def classify(meas: decay.Record, status: np.ndarray, epsilon: float,
              verdicts: np.ndarray) -> np.ndarray:  # fmt: skip
     """The stability class of each member (int8, codes of :data:`CLASSES`) from its
@@ -119,7 +147,7 @@ def classify(meas: decay.Record, status: np.ndarray, epsilon: float,
     cls[floor_high] = FLOOR_ABOVE_EPSILON
     cls[verdicts == V_UNSTABLE] = GROWING
     cls[verdicts == V_UNDECIDED] = UNDECIDED
-    blown = np.isin(status, [int(s) for s in _BLOWN_UP])
+    blown = blown_up(status)
     cls[blown] = DIVERGED
     cls[(status != 0) & ~blown] = NOT_RUN
     return cls
@@ -200,7 +228,7 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
         put(ended_low & ~grew, V_STABLE, R_.DECAYED)
         with np.errstate(invalid="ignore"):
             put(grew & (d4 > d0), V_UNSTABLE, R_.GREW)
-    blown = np.isin(status, [int(s) for s in _BLOWN_UP])
+    blown = blown_up(status)
     put(blown, V_UNSTABLE, R_.BLEW_UP)
     if theory_known and rho < 1.0:
         # the divergence threshold stopped a transient the law allows: no evidence

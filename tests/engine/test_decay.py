@@ -517,3 +517,23 @@ def test_pooled_end_is_the_general_one_and_refuses_other_sums():
         run(decay.map_estimate_pooled, full, -1)
     with pytest.raises(AssertionError, match="generator"):
         run(decay.map_estimate_pooled, pooled, 1, gen_h=tau)
+
+
+@pytest.mark.parametrize("shape", [(1000, 1), (1000, 2), (999, 7), (0, 3), (5, 30)])
+def test_row_reductions_are_numpys(shape):
+    """The members' per-row reductions written column by column (``alpha0_norm``, the
+    finite initial states, the blown-up statuses) give numpy's reductions along the rows,
+    NaN and the infinities included."""
+    from stabdae import _measures as M
+
+    rng = np.random.default_rng(shape[0] + shape[1])
+    a = rng.standard_normal(shape) * 10.0 ** rng.integers(-300, 300, shape)
+    if a.shape[0]:
+        for value in (np.nan, np.inf, -np.inf, -0.0):
+            a[rng.integers(0, shape[0]), rng.integers(0, shape[1])] = value
+    np.testing.assert_array_equal(M.row_max_abs(a), np.max(np.abs(a), axis=1, initial=-np.inf)
+                                  if a.shape[0] == 0 else np.max(np.abs(a), axis=1))
+    np.testing.assert_array_equal(M.rows_finite(a), np.isfinite(a).all(axis=1))
+    status = rng.integers(-3, 9, shape[0]).astype(np.int8)
+    np.testing.assert_array_equal(M.blown_up(status),
+                                  np.isin(status, [int(s) for s in M._BLOWN_UP]))
