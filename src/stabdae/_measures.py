@@ -295,7 +295,10 @@ def median_interval(values, level: float = 0.95) -> tuple[float, float, float, f
     n = v.size
     if n == 0:
         return math.nan, math.nan, math.nan, math.nan
-    med = float(np.median(v))
+    # from the sorted values, as np.median takes it (the mean of the middle two for an
+    # even n), without its second pass over them
+    h = n // 2
+    med = float(v[h]) if n % 2 else float((v[h - 1] + v[h]) / 2.0)
     k, coverage = _median_rank(n, float(level))
     return med, float(v[k - 1]), float(v[n - k]), coverage
 
