@@ -625,11 +625,12 @@ def build_block_kernel(K, spec: Spec):
                 if until_save == 0:  # a stored sample, of the members whose steps succeeded
                     until_save = save_every
                     block_norms(X, t0 + i * tau, p_s, gr, nrm_b, dn_b, Gb)
+                    sample = i // save_every  # (once: in the loop, a division per member)
                     for j in range(cnt):
                         if active[j]:
                             nrm = nrm_b[j]
                             if trace_row[lo + j] >= 0:
-                                out_norm[trace_row[lo + j], i // save_every] = nrm
+                                out_norm[trace_row[lo + j], sample] = nrm
                             if not (nrm <= threshold):
                                 status[lo + j] = _DIVERGED
                                 fail_step[lo + j] = i
