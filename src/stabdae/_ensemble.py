@@ -871,25 +871,30 @@ def _referee(run: _RunSpec, g_ref, band=None) -> dict:
     alone, or ``band`` where that run was read from the members' own, :func:`_integrate`),
     and, where ``Ã`` is constant, ``ρ`` of the one-step propagator and ``sup ‖R^k‖∞`` per
     fifth (:func:`.theory.fifth_bounds`)."""
-    if band is not None:
-        pass
-    elif g_ref is not None and g_ref.shape[0] > 1:
-        if run.adaptive:  # rows (t, g) at the reference's accepted steps, fifths by time
-            t = g_ref[:, 0]
-            fifth = np.minimum(4, (5.0 * (t - run.t0) / (run.t_end - run.t0)).astype(int))
-            norms = np.abs(g_ref[:, 1:]).max(axis=1)
-        else:
-            nsteps = g_ref.shape[0] - 1
-            fifth = np.minimum(4, (5 * np.arange(nsteps + 1)) // nsteps)
-            norms = np.abs(np.asarray(g_ref, dtype=float)).max(axis=1)
-        band = np.array([norms[fifth == w].max(initial=0.0) for w in range(5)])
-    else:
-        band = _reference_floor(run)
+    if band is None:
+        band = _floor_band(run, g_ref)
     if run.R.shape[0] == 0:
         return dict(floor_band=band, bounds=None, rho=math.nan, divergence=run.divergence)
     rho = float(np.max(np.abs(np.linalg.eigvals(run.R))))
     return dict(floor_band=band, bounds=theory.fifth_bounds(run.R, run.mode.prediction_steps),
                 rho=rho, divergence=run.divergence)  # fmt: skip
+
+
+def _floor_band(run: _RunSpec, g_ref) -> np.ndarray:
+    """The reference trajectory's largest residual per fifth of the run: from its stored
+    residuals ``g_ref``, or where there are none from a run of the reference state alone
+    (:func:`_reference_floor`)."""
+    if g_ref is None or g_ref.shape[0] <= 1:
+        return _reference_floor(run)
+    if run.adaptive:  # rows (t, g) at the reference's accepted steps, fifths by time
+        t = g_ref[:, 0]
+        fifth = np.minimum(4, (5.0 * (t - run.t0) / (run.t_end - run.t0)).astype(int))
+        norms = np.abs(g_ref[:, 1:]).max(axis=1)
+    else:
+        nsteps = g_ref.shape[0] - 1
+        fifth = np.minimum(4, (5 * np.arange(nsteps + 1)) // nsteps)
+        norms = np.abs(np.asarray(g_ref, dtype=float)).max(axis=1)
+    return np.array([norms[fifth == w].max(initial=0.0) for w in range(5)])
 
 
 def _reference_floor(run: _RunSpec) -> np.ndarray:

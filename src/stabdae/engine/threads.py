@@ -76,7 +76,8 @@ def _run_shared(kernel, chunks, threads: int, progress, items: int) -> None:
     as much as a small call's work).  ``progress`` is called from the calling thread
     after each chunk it runs and once at the end.  A chunk that raises, or an interrupt
     of the calling thread, stops every thread before its next chunk; the chunks running
-    end before this returns, and the first error is raised."""
+    end before this returns, and the error is raised (the calling thread's own where it
+    has one, else a worker's)."""
     taken = itertools.count()  # ``next`` is atomic: each chunk is taken once
     lock = threading.Lock()
     state = {"done": 0, "stop": False}
