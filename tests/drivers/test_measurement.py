@@ -445,3 +445,20 @@ def test_a_law_whose_step_is_a_multiple_of_the_identity():
     assert np.all(np.abs(ratio - 1) < 0.01), np.sort(ratio)
     assert reference_logs(R).shape == (1,)
     assert reference_logs(np.array([[0.5, 1e-3], [0.0, 0.5]])).shape == (2,)
+
+
+def test_a_members_measures_do_not_depend_on_its_place_in_the_ensemble():
+    """Each member's measures, its linear prediction included, are its own: the same
+    members given in reverse order get the same values, member by member.  Among them
+    members fitted by their envelope, whose prediction is stepped from their own ``α⁰``
+    (a kernel that read another member's row would give them another prediction)."""
+    model = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    x0 = stabdae.sample_perturbations(model, 400, (1e-6, 1e-2), seed=1)[0]
+    runs = [stabdae.ensemble(model, law, "midpoint", 1e-3, 2.0, x0=x, save_dt=0.05)
+            for x in (x0, x0[::-1])]  # fmt: skip
+    forward, backward = runs[0], runs[1].isel(member=slice(None, None, -1))
+    envelope = (forward["fit_kind"] != decay.K_NONE) & (forward["fit_kind"] != decay.K_MAP)
+    assert int((envelope & np.isfinite(forward["beta_predicted"])).sum()) >= 3
+    for name in ("beta", "gamma", "beta_predicted", "fit_kind", "beta_reason", "x_final"):
+        np.testing.assert_array_equal(forward[name].values, backward[name].values, name)

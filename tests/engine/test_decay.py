@@ -59,6 +59,10 @@ def test_ladder_records_are_the_right_envelope(below):
     lowest = 0 if below is None else min(level) + below
     assert lowest < decay.NBINS - 100  # (the full scan's 512 levels are not all visited)
     n = decay.records(lt, lv, 0, rt, ry, *(() if below is None else (lowest,)))
+    # from the highest level visited down (as a member's end passes it): the same points
+    rt2, ry2 = np.empty(decay.NBINS), np.empty(decay.NBINS)
+    n2 = decay.records(lt, lv, 0, rt2, ry2, lowest, decay.ladder_top(lt, 0))
+    assert n2 == n and rt2[:n].tolist() == rt[:n].tolist() and ry2[:n].tolist() == ry[:n].tolist()
     last_on_level = {lev: i for i, lev in enumerate(level) if lev >= lowest}
     kept = list(last_on_level.values())
     expect = sorted(i for i in kept if v[i] > max((v[q] for q in kept if q > i), default=0.0))
@@ -66,6 +70,25 @@ def test_ladder_records_are_the_right_envelope(below):
     np.testing.assert_array_equal(ry[:n], np.log(v[expect]))
     if below == 3:  # the lowest level's point, the last sample, is left out
         assert expect[-1] < v.size - 1
+
+
+def test_ladder_top_is_the_highest_level_visited():
+    """:func:`decay.ladder_top` is the highest level with a time (−1 for none), as NumPy
+    finds it: on rows visited at random above and below the initial level, only below it
+    (the scan's second part), only at the bottom or the top level, on the initial level
+    alone, and on none."""
+    start = decay.NBINS - 1 - decay.ladder.ABOVE
+    rng = np.random.default_rng(8)
+    rows = [rng.choice(decay.NBINS, size=k, replace=False) for k in (1, 5, 40, 300)]
+    rows += [rng.choice(start, size=k, replace=False) for k in (1, 7, 200)]
+    rows += [np.array([0]), np.array([decay.NBINS - 1]), np.array([start]), np.array([], int)]
+    lt, lv, base = decay.ladders(len(rows))
+    for j, visited in enumerate(rows):
+        decay.ladder_clear(lt, j)
+        lt[j, visited] = rng.random(visited.size)
+        lt[j, decay.NBINS] = 1.0  # the spare column (a non-finite norm's) is no level
+    for j, visited in enumerate(rows):
+        assert decay.ladder_top(lt, j) == (visited.max() if visited.size else -1), visited
 
 
 def test_map_gamma_is_the_largest_product_on_the_envelope():

@@ -88,6 +88,7 @@ from .ladder import (  # noqa: F401
     ladder_base,
     ladder_clear,
     ladder_level,
+    ladder_top,
     ladders,
     log_normal,
     records,

@@ -142,15 +142,34 @@ def ladder_clear(lt, j):
 
 
 @njit(cache=True, _nrt=False)
-def records(lt, lv, j, rt, ry, lowest=0):
+def ladder_top(lt, j):
+    """The highest level of ladder row ``j`` visited (−1 for none).  A member's initial
+    norm lies on level ``NBINS − 1 − ABOVE`` (unless it is zero or not finite), so the
+    levels from there up are scanned first, in a loop without branches that vectorizes
+    (a scan down from the top, stopping at the first visited level, went through the
+    ``ABOVE`` levels one by one for every member that never rose above its start)."""
+    row = lt[j]
+    top = -1
+    for b in range(_START_BIN, NBINS):
+        top = max(top, b if row[b] >= 0.0 else -1)
+    if top < 0:
+        for b in range(_START_BIN - 1, -1, -1):
+            if row[b] >= 0.0:
+                return b
+    return top
+
+
+@njit(cache=True, _nrt=False)
+def records(lt, lv, j, rt, ry, lowest=0, top=NBINS - 1):
     """The right-envelope points of ladder row ``j``, in time order, into ``rt`` (times)
     and ``ry`` (log norms); returns their number.  The last sample on a level lies on the
     envelope exactly when no higher level was visited later.  ``lowest``: no level below
-    it was visited (the scan stops there: an unvisited level is never a point)."""
+    it was visited; ``top``: none above it (the scan runs between them: an unvisited
+    level is never a point)."""
     n = 0
     latest = -1.0
     normal = True  # every norm positive, finite and normal
-    for b in range(NBINS - 1, max(lowest, 0) - 1, -1):
+    for b in range(min(top, NBINS - 1), max(lowest, 0) - 1, -1):
         t = lt[j, b]
         if t > latest:
             latest = t

@@ -9,7 +9,7 @@ from numba import njit
 
 from ..jit import variant
 from .fit import MIN_DECADES, STILL_DECAYING, estimate, grows, refit
-from .ladder import NBINS, ladder_base, ladder_clear, ladder_level, records
+from .ladder import NBINS, ladder_base, ladder_clear, ladder_level, ladder_top, records
 from .onestep import map_estimate, map_estimate_pooled
 from .record import (
     C_BETA,
@@ -92,7 +92,8 @@ def finish(lt, lv, meas, codes, j, row, final, stopped, dt, rt, ry, a, b, lg):
     the norm at its last state; ``stopped``: it did not run to the end)."""
     still = summarize(meas, codes, row, final, stopped)
     if not stopped:
-        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg)
+        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, 0,
+                     ladder_top(lt, j))  # fmt: skip
 
 
 @njit(cache=True)
@@ -113,19 +114,20 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
     still = summarize(meas, codes, row, final, stopped)
     if stopped:
         return
+    top = ladder_top(lt, j)  # (for the map and the envelope: found once)
     # a late rise a decade or more below the start is the floor moving with the motion
     # (the member drifting from the reference), not growth: the map reads the transient
     # before it
     drift = meas[row, C_D4] * 10.0**MIN_DECADES <= meas[row, C_INITIAL]
     if grows(meas[row, C_D2], meas[row, C_D3], meas[row, C_D4]) and not drift:
-        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest)
+        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top)
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                         lowest, gen_h, floor_min, low_bin)  # fmt: skip
+                         lowest, gen_h, floor_min, low_bin, top)  # fmt: skip
     elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                          lowest, gen_h, floor_min, low_bin):  # fmt: skip
+                          lowest, gen_h, floor_min, low_bin, top):  # fmt: skip
         if envelope:
-            fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest)
+            fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top)
         else:
             codes[row, I_POINTS] = 0
             codes[row, I_KIND] = K_NONE
@@ -133,11 +135,12 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
 
 
 @njit(cache=True, _nrt=False)
-def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest=0):
+def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest=0,
+                 top=NBINS - 1):  # fmt: skip
     """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
-    ``still``: the run ended while it was decaying; ``lowest``: no level below it was
-    visited)."""
-    n = records(lt, lv, j, rt, ry, lowest)
+    ``still``: the run ended while it was decaying; ``lowest``, ``top``: no level below
+    the one or above the other was visited)."""
+    n = records(lt, lv, j, rt, ry, lowest, top)
     estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row], codes[row])
 
 
@@ -171,9 +174,11 @@ def summarize(meas, codes, row, final, stopped):
 
 
 @njit(cache=True, _nrt=False)
-def predict(R, alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b, lg, g, gn,
-            rho_R):  # fmt: skip
-    """Member ``row``'s predicted rate: ``g_{k+1} = R g_k`` from ``g_0 = alpha`` over the
+def predict(R, alphas, i_alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b, lg,
+            g, gn, rho_R):  # fmt: skip
+    """Member ``row``'s predicted rate: ``g_{k+1} = R g_k`` from ``g_0 = alphas[i_alpha]``
+    (the row read in place: a view of a shared array is a reference count taken and
+    dropped, two atomic operations on a cache line every thread writes) over the
     steps up to its fit window's end, through ladder row ``j``, fitted over the measured
     window with the measured kind; ``−ln ρ(R)/h`` for a member measured by its one-step
     map (``rho_R``: :func:`.onestep.spectral_radius_of` ``R``, taken once for all).
@@ -185,11 +190,11 @@ def predict(R, alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt, ry, a, b
     if codes[row, I_KIND] == K_MAP:  # the map fitted to g_{k+1} = R g_k is R itself
         out[C_BETA_PRED] = -math.log(rho_R) / h
         return
-    ng = alpha.shape[0]
+    ng = alphas.shape[1]
     ladder_clear(lt, j)
     nrm = 0.0
     for i in range(ng):
-        g[i] = alpha[i]
+        g[i] = alphas[i_alpha, i]
         nrm = max(nrm, abs(g[i]))
     base[j] = ladder_base(nrm)
     t_hi = out[C_FIT_END]

@@ -21,6 +21,7 @@ from .ladder import (
     float_bits,
     float_from_bits,
     ladder_level,
+    ladder_top,
     log2_biased,
     log_normal,
     trailing_zeros,
@@ -223,7 +224,7 @@ def block_levels(gn, dn, base, low, nlev, wmax, dmax):
     return changed
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, forceinline=True, _nrt=False)
 def _store(S, A, j, bin_, pooled, full):
     """Slot ``j``'s sums so far as those of its bin ``bin_`` (``pooled ≥ 0``: the pooled
     map's; else the full map's of ``full`` components, none when 0)."""
@@ -251,7 +252,7 @@ def _store(S, A, j, bin_, pooled, full):
         S[j, bin_, 2 * full * full] = A[c, j]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def bin_flush(S, A, nlev, low, mask, pooled, full):
     """The slots of the set bits of ``mask``, whose level went below the lowest bin they
     had reached: their sums so far (the pair just added, from a state above, included)
@@ -266,7 +267,7 @@ def bin_flush(S, A, nlev, low, mask, pooled, full):
         low[j] = nb
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def end_flush(S, A, low, active, pooled, full):
     """At the end of the run: each running slot's sums as those of the lowest bin it
     reached, ``low[j]`` (zero when no state was measured).  The bins below hold the same
@@ -277,7 +278,7 @@ def end_flush(S, A, low, active, pooled, full):
             _store(S, A, j, low[j], pooled, full)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
     """The largest norms of fifth ``window`` so far to the rows of the running members;
     then cleared."""
@@ -289,7 +290,7 @@ def windows_flush(meas, wmax, dmax, window, active, lo, cnt):
         dmax[j] = -math.inf
 
 
-@njit(cache=True, forceinline=True, error_model="numpy")
+@njit(cache=True, forceinline=True, error_model="numpy", _nrt=False)
 def window_flush(meas, wmax, dmax, window, j, row):
     """Slot ``j``'s largest norms of fifth ``window`` so far to its member's row ``row``
     (kept in the slot: a largest norm flushed twice is the same largest norm).  Each
@@ -753,7 +754,7 @@ def _map_gamma(lt, lv, j, lo, top, beta, w):
 
 @njit(cache=True)
 def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref,
-                 lowest=0, gen_h=0.0, floor_min=0.0, low_bin=0):  # fmt: skip
+                 lowest=0, gen_h=0.0, floor_min=0.0, low_bin=0, top=-1):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
@@ -775,17 +776,15 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
     reference has a floor of its own, the local errors of steps that fall apart from the
     reference's, which its last fifth may not show).  ``low_bin``: the lowest bin the
     member's level went below, whose sums are those of every bin below it too (read from
-    it: :func:`end_flush`).  Returns whether it gave β."""
+    it: :func:`end_flush`).  ``top``: the highest level visited (:func:`.ladder.ladder_top`;
+    found here when negative).  Returns whether it gave β."""
     if S.shape[2] == 0:
         return False
     floor = max(meas[row, C_D4], floor_min)
     still = (meas[row, C_D2] > meas[row, C_D3] > meas[row, C_D4]
              and meas[row, C_D2] >= MAP_STILL_DECAYING * meas[row, C_D4])  # fmt: skip
-    top = -1
-    for b in range(NBINS - 1, -1, -1):
-        if lt[j, b] >= 0.0:
-            top = b
-            break
+    if top < 0:
+        top = ladder_top(lt, j)
     per_decade = LEVELS_PER_OCTAVE * math.log2(10.0) * MIN_DECADES
     for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, GENERATOR_MARGIN):
         if margin == GENERATOR_MARGIN and not gen_h > 0.0:

@@ -40,7 +40,7 @@ def _measure_rows(norms, times, meas, codes, R, alphas, lo, hi):
             last = v
         finish(lt, lv, meas, codes, 0, r, last, stopped, dt, rt, ry, a, b, lg)
         if R.shape[0] > 0:
-            predict(R, alphas[r], T - 1, dt, lt, lv, base, meas, codes, 0, r, rt, ry, a, b, lg,
+            predict(R, alphas, r, T - 1, dt, lt, lv, base, meas, codes, 0, r, rt, ry, a, b, lg,
                     g, gn, rho_R)  # fmt: skip
 
 

@@ -231,7 +231,7 @@ def ensemble_kernel_for(model, bound, scheme, block: int = BLOCK):
 # ensemble.
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def retire(X, j, row, active, code, x_final, x_last):
     """Stop slot ``j``.  Its member, output ``row`` (``-1``: padding, or a slot that
     was already stopped), gets ``x_last`` as its final state; the slot then takes the
@@ -248,7 +248,7 @@ def retire(X, j, row, active, code, x_final, x_last):
             break
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def stop_failed(X, X_last, code, active, lo, cnt, step, status, fail_step, x_final,
                 x_last):  # fmt: skip
     """Stop every slot with a status in ``code`` or a non-finite state: its member, if
@@ -276,7 +276,7 @@ def stop_failed(X, X_last, code, active, lo, cnt, step, status, fail_step, x_fin
     return stopped
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def block_failed(X, code):
     """Whether a slot's steps since the last check failed: a status in ``code`` or a
     non-finite state (which stays non-finite once it is).  (Slots innermost: the loops
@@ -677,7 +677,7 @@ def build_block_kernel(K, spec: Spec):
                               ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb, lg,
                               ref, low_bin=low[j])  # fmt: skip
                 if R.shape[0] > 0:
-                    predict(R, alpha0s[lo + j], nsteps // stride, stride * tau, lt, lv, base,
+                    predict(R, alpha0s, lo + j, nsteps // stride, stride * tau, lt, lv, base,
                             meas, mcodes, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p,
                             rho_R)  # fmt: skip
 

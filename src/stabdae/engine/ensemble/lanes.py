@@ -392,7 +392,7 @@ def _build_adaptive_block(K, spec: Spec):
                                     base[lane], 0, span / max(acc_n[lane], 1), rt, ry, fa,
                                     fb, lg, ref, h_pred, floor_min, NR == 0)  # fmt: skip
                     if R.shape[0] > 0:
-                        predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt, lv,
+                        predict(R, alpha0s, i, int(round(span / h_pred)), h_pred, lt, lv,
                                 base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
                                 gn_p, rho_R)  # fmt: skip
                     mem[lane] = -1
@@ -462,7 +462,7 @@ def _build_adaptive_block(K, spec: Spec):
                         finish(lt, lv, meas, mcodes, lane, i, math.nan, True, span, rt, ry, fa, fb,
                                lg)  # fmt: skip
                         if R.shape[0] > 0:
-                            predict(R, alpha0s[i], int(round(span / h_pred)), h_pred, lt,
+                            predict(R, alpha0s, i, int(round(span / h_pred)), h_pred, lt,
                                     lv, base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
                                     gn_p, rho_R)  # fmt: skip
                         continue
