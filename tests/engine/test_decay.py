@@ -72,6 +72,25 @@ def test_ladder_records_are_the_right_envelope(below):
         assert expect[-1] < v.size - 1
 
 
+def test_a_members_start_clears_its_ladder_from_the_level_given():
+    """:func:`decay.begin` clears the levels from ``clear_from`` up (a member's run
+    leaves none below its lowest level written) and leaves those below as they are; with
+    no level given, all of them."""
+    lt, lv, base = decay.ladders(1)
+    meas = np.zeros((1, decay.NCOLS))
+    codes = np.zeros((1, decay.NCODES), dtype=np.int64)
+    for clear_from in (0, 5, 300, decay.NBINS - 1):
+        lt[0] = 7.0
+        decay.begin(lt, lv, base, meas, codes, 0, 0, 1e-3, 1e-3, clear_from)
+        start = decay.NBINS - 1 - decay.ladder.ABOVE
+        expect = np.where(np.arange(decay.NBINS) < clear_from, 7.0, -1.0)
+        expect[start] = 0.0  # the initial norm's level, at time 0
+        np.testing.assert_array_equal(lt[0, : decay.NBINS], expect)
+    lt[0] = 7.0
+    decay.begin(lt, lv, base, meas, codes, 0, 0, 1e-3, 1e-3)
+    assert (lt[0, : decay.NBINS] <= 0.0).all()
+
+
 def test_ladder_top_is_the_highest_level_visited():
     """:func:`decay.ladder_top` is the highest level with a time (−1 for none), as NumPy
     finds it: on rows visited at random above and below the initial level, only below it

@@ -9,7 +9,15 @@ from numba import njit
 
 from ..jit import variant
 from .fit import MIN_DECADES, STILL_DECAYING, estimate, grows, refit
-from .ladder import NBINS, ladder_base, ladder_clear, ladder_level, ladder_top, records
+from .ladder import (
+    NBINS,
+    ladder_base,
+    ladder_clear,
+    ladder_clear_from,
+    ladder_level,
+    ladder_top,
+    records,
+)
 from .onestep import map_estimate, map_estimate_pooled
 from .record import (
     C_BETA,
@@ -69,10 +77,14 @@ def observe(lt, lv, base, meas, j, row, t, v, d, window):  # costs as much as th
 
 
 @njit(cache=True, _nrt=False)
-def begin(lt, lv, base, meas, codes, j, row, g0, d0):
+def begin(lt, lv, base, meas, codes, j, row, g0, d0, clear_from=0):
     """Start member ``row`` on ladder row ``j`` with its initial norms (as
-    :func:`observe`'s); every column of its record is written here or at its end."""
-    ladder_clear(lt, j)
+    :func:`observe`'s); every column of its record is written here or at its end.
+    ``clear_from``: no level of the row below it holds a time (the ladder is cleared
+    from there up: a member's run writes the levels from its lowest one up, and the
+    clear of all ``NBINS`` levels, 4 kB outside the first-level cache, was most of a
+    member's start)."""
+    ladder_clear_from(lt, j, clear_from)
     base[j] = ladder_base(d0)
     for c in range(NCOLS):
         meas[row, c] = math.nan
@@ -182,14 +194,15 @@ def predict(R, alphas, i_alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt
     steps up to its fit window's end, through ladder row ``j``, fitted over the measured
     window with the measured kind; ``−ln ρ(R)/h`` for a member measured by its one-step
     map (``rho_R``: :func:`.onestep.spectral_radius_of` ``R``, taken once for all).
-    ``g``, ``gn`` are scratch of the residual's size."""
+    ``g``, ``gn`` are scratch of the residual's size.  Returns the lowest level of the
+    ladder row it wrote (``NBINS``: none; the row is then as it was, or cleared)."""
     out = meas[row]
     out[C_BETA_PRED] = math.nan
     if codes[row, I_REASON] != R_FITTED:
-        return
+        return NBINS
     if codes[row, I_KIND] == K_MAP:  # the map fitted to g_{k+1} = R g_k is R itself
         out[C_BETA_PRED] = -math.log(rho_R) / h
-        return
+        return NBINS
     ng = alphas.shape[1]
     ladder_clear(lt, j)
     nrm = 0.0
@@ -219,6 +232,7 @@ def predict(R, alphas, i_alpha, nsteps, h, lt, lv, base, meas, codes, j, row, rt
     n = records(lt, lv, j, rt, ry, lowest)
     out[C_BETA_PRED] = refit(rt, ry, n, out[C_FIT_START], t_hi, codes[row, I_KIND], h, a, b, lg,
                              out[C_SHIFT])  # fmt: skip
+    return lowest
 
 
 #: :func:`finish_with_map` for the pooled one-step map of fixed steps, compiled without

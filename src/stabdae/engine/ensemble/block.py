@@ -486,6 +486,11 @@ def build_block_kernel(K, spec: Spec):
         for l in range(ng):
             gr[l] = 0.0
         lt, lv, base = ladders(B)  # the decay measurement's ladder per slot
+        # per slot, a level below which its ladder holds no time (its members' starts
+        # clear it from there up; 0 until a member has ended there: the rows are new)
+        clear_from = stack_int1(B)
+        for j in range(B):
+            clear_from[j] = 0
         rt, ry, fa, fb, lg = scratch()
         # The measurement (the block functions of :mod:`.decay`): the one-step map's sums per
         # slot and bin, fed from the measured states' g − g_ref (Dv: each step's g, made
@@ -552,7 +557,7 @@ def build_block_kernel(K, spec: Spec):
                 nrm = nrm_b[j]
                 if trace_row[lo + j] >= 0:
                     out_norm[trace_row[lo + j], 0] = nrm
-                begin(lt, lv, base, meas, mcodes, j, lo + j, nrm, dn_b[j])
+                begin(lt, lv, base, meas, mcodes, j, lo + j, nrm, dn_b[j], clear_from[j])
                 map_begin(S_map, j, low[j])
                 active[j] = True
                 alive += 1
@@ -676,10 +681,14 @@ def build_block_kernel(K, spec: Spec):
                 finish_member(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
                               ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb, lg,
                               ref, low_bin=low[j])  # fmt: skip
+                written = lowest  # (the prediction's run writes the ladder anew)
                 if R.shape[0] > 0:
-                    predict(R, alpha0s, lo + j, nsteps // stride, stride * tau, lt, lv, base,
-                            meas, mcodes, j, lo + j, rt, ry, fa, fb, lg, g_p, gn_p,
-                            rho_R)  # fmt: skip
+                    written = predict(R, alpha0s, lo + j, nsteps // stride, stride * tau, lt,
+                                      lv, base, meas, mcodes, j, lo + j, rt, ry, fa, fb, lg,
+                                      g_p, gn_p, rho_R)  # fmt: skip
+                clear_from[j] = min(lowest, written)
+            for j in range(cnt, B):  # (padding: its ladder written, no end to say where)
+                clear_from[j] = 0
 
     key = spec.key(K.key)
     tag(key, block_norms, step, *(() if by_stage else (member_step,)), pairs_full,
