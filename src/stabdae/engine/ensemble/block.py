@@ -183,6 +183,7 @@ BUFFERS = {
     "gr": ("stack1(ng)", "the reference's residual at the current step"),
     "Gb": ("stack2(ng, B)", "the slots' residuals at a stored sample"),
     "lt, lv, base": ("ladders(B)", "each slot's ladder: times, norms, offset"),
+    "clear_from": ("stack_int1(B)", "each slot's level below which its ladder holds no time"),
     "rt, ry, fa, fb, lg": ("scratch()", "the fits' scratch"),
     "S_map": ("map_buffers(B, ng, pooled)", "the one-step map's sums per slot and bin"),
     "Dv": ("stack2(ng, B)", "each slot's g (then g − g_ref) at a measured state"),
@@ -681,7 +682,7 @@ def build_block_kernel(K, spec: Spec):
                 finish_member(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
                               ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb, lg,
                               ref, low_bin=low[j])  # fmt: skip
-                written = lowest  # (the prediction's run writes the ladder anew)
+                written = lowest  # (a prediction clears the row and writes levels of its own)
                 if R.shape[0] > 0:
                     written = predict(R, alpha0s, lo + j, nsteps // stride, stride * tau, lt,
                                       lv, base, meas, mcodes, j, lo + j, rt, ry, fa, fb, lg,
