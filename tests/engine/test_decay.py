@@ -544,7 +544,8 @@ def test_pooled_end_is_the_general_one_and_refuses_other_sums():
         meas[0, decay.C_D2:decay.C_D4 + 1] = 0.0
         codes = np.zeros((1, decay.NCODES), np.int64)
         rt, ry = np.empty(decay.NBINS), np.empty(decay.NBINS)
-        ok = fn(S, 0, 2, pm, lt, lv, 0, meas, codes, 0, tau, rt, ry, ref, 0, gen_h)
+        top = decay.ladder_top(lt, 0)
+        ok = fn(S, 0, 2, pm, lt, lv, 0, meas, codes, 0, tau, rt, ry, ref, top, 0, gen_h)
         return ok, meas, codes
 
     general, variant = run(decay.map_estimate, pooled, 1), run(decay.map_estimate_pooled, pooled, 1)

@@ -228,7 +228,7 @@ def test_the_kernels_per_member_and_per_state_calls_take_no_reference_counts():
     check are compiled without numba's reference counting: each call of one compiled with
     it takes and drops a reference to every heap array it is given, two atomic operations
     on a cache line that every thread writes (the members' outputs are one array for all
-    threads), which cost about a tenth of a member's whole start and end.  (A member's
+    threads): 16 % of a 100-step kernel call of 10⁴ pendulums in ``perf``.  (A member's
     ``α⁰`` goes to its prediction as the shared array and its row, not as a view, for the
     same reason.)"""
     from stabdae.engine import decay

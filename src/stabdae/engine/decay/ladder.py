@@ -136,17 +136,16 @@ def ladder_level(v, base):
 
 
 @njit(cache=True, _nrt=False)
-def ladder_clear(lt, j):
-    """Ladder row ``j`` with no level visited."""
-    for b in range(NBINS):
-        lt[j, b] = -1.0
-
-
-@njit(cache=True, _nrt=False)
 def ladder_clear_from(lt, j, first):
     """Ladder row ``j`` with no level visited, where none below ``first`` (≥ 0) was."""
     for b in range(max(first, 0), NBINS):
         lt[j, np.uint64(b)] = -1.0
+
+
+@njit(cache=True, _nrt=False)
+def ladder_clear(lt, j):
+    """Ladder row ``j`` with no level visited."""
+    ladder_clear_from(lt, j, 0)
 
 
 @njit(cache=True, _nrt=False)

@@ -135,9 +135,9 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
         fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top)
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                         lowest, gen_h, floor_min, low_bin, top)  # fmt: skip
+                         top, lowest, gen_h, floor_min, low_bin)  # fmt: skip
     elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                          lowest, gen_h, floor_min, low_bin, top):  # fmt: skip
+                          top, lowest, gen_h, floor_min, low_bin):  # fmt: skip
         if envelope:
             fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top)
         else:

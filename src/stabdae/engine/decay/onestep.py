@@ -21,7 +21,6 @@ from .ladder import (
     float_bits,
     float_from_bits,
     ladder_level,
-    ladder_top,
     log2_biased,
     log_normal,
     trailing_zeros,
@@ -762,8 +761,8 @@ def _map_gamma(lt, lv, j, lo, top, beta, w):
 
 
 @njit(cache=True)
-def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref,
-                 lowest=0, gen_h=0.0, floor_min=0.0, low_bin=0, top=-1):  # fmt: skip
+def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref, top,
+                 lowest=0, gen_h=0.0, floor_min=0.0, low_bin=0):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
@@ -785,15 +784,13 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
     reference has a floor of its own, the local errors of steps that fall apart from the
     reference's, which its last fifth may not show).  ``low_bin``: the lowest bin the
     member's level went below, whose sums are those of every bin below it too (read from
-    it: :func:`end_flush`).  ``top``: the highest level visited (:func:`.ladder.ladder_top`;
-    found here when negative).  Returns whether it gave β."""
+    it: :func:`end_flush`).  ``top``: the highest level visited (:func:`.ladder.ladder_top`).
+    Returns whether it gave β."""
     if S.shape[2] == 0:
         return False
     floor = max(meas[row, C_D4], floor_min)
     still = (meas[row, C_D2] > meas[row, C_D3] > meas[row, C_D4]
              and meas[row, C_D2] >= MAP_STILL_DECAYING * meas[row, C_D4])  # fmt: skip
-    if top < 0:
-        top = ladder_top(lt, j)
     per_decade = LEVELS_PER_OCTAVE * math.log2(10.0) * MIN_DECADES
     for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, GENERATOR_MARGIN):
         if margin == GENERATOR_MARGIN and not gen_h > 0.0:
