@@ -37,13 +37,15 @@ def model_file(source) -> Path:
     """The resolved path of a model file or of a built-in scene's file."""
     path = Path(source)
     if path.suffix != ".py":
-        candidate = scene_dir() / f"{source}.py"
-        if not candidate.is_file():
+        # a scene is a name, never a path: joined onto the scenes folder, a name with a
+        # folder in it ("../x", "/usr/lib/python3/this") would import a file nobody named
+        # as code
+        if str(source) not in scene_names():
             raise ModelError(
-                f"load_model: {source!r} is neither a .py model file nor a built-in scene; "
-                f"scenes: {scene_names()}"
+                f"load_model: {str(source)!r} is neither a .py model file nor a built-in "
+                f"scene (a scene is given by its name alone); scenes: {scene_names()}"
             )
-        path = candidate
+        path = scene_dir() / f"{source}.py"
     if not path.is_file():
         raise ModelError(f"load_model: no such model file: {path}")
     return path.resolve()

@@ -40,7 +40,7 @@ from ..engine.crash import guard
 from ..engine.jit import compile_seconds
 from .report import summary
 from .spec import Study, StudyError, load_study, members_text, most_members
-from .store import Manifest, Store, clear, stack
+from .store import Manifest, Store, clear, file_kind, regular_file, stack
 from .theory import axis_units, for_study
 
 __all__ = ["run_study", "run_point", "combine"]
@@ -179,6 +179,11 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
         raise FileExistsError(f"{out} exists and is not a stabdae dataset; it is not replaced "
                               "(give another output with -o)")  # fmt: skip
     parts = out.with_name(out.name + ".parts")
+    if os.path.lexists(parts) and (parts.is_symlink() or not parts.is_dir()):
+        # before any computing: a link would put the parts, and their removal, elsewhere
+        raise FileExistsError(f"{parts} is {file_kind(parts)}, not a folder of a run's parts; "
+                              "it is left as it is: move it away or give another output "
+                              "with -o")  # fmt: skip
     stamp = _fingerprint(study)
     log(study.describe())
     existed = parts.exists() and any(p.name != "lock" for p in parts.iterdir())
@@ -196,7 +201,8 @@ def run_study(study, output=None, *, force: bool = False, members: int | None = 
                               "output folder you can write with -o") from None  # fmt: skip
     try:
         for orphan in out.parent.glob(f".{out.name}.*.tmp"):  # left by a killed write
-            orphan.unlink(missing_ok=True)
+            if regular_file(orphan):
+                orphan.unlink(missing_ok=True)
         old = Manifest.read(parts) if existed else None
         if old is not None and old.fingerprint != stamp:
             if old.study == str(study.path.resolve()):
@@ -228,6 +234,10 @@ def _lock(parts: Path) -> Path:
         try:
             fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
         except FileExistsError:
+            if not regular_file(lock):  # a FIFO would block the read below
+                raise FileExistsError(f"{lock} is {file_kind(lock)}, not the lock a run "
+                                      "writes; it is left as it is: move it away or give "
+                                      "another output with -o") from None  # fmt: skip
             try:
                 pid = int(lock.read_text().split()[0])
             except (OSError, ValueError, IndexError):

@@ -241,7 +241,7 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
     try:
         model = load_model(source)
     except ModelError as exc:
-        fail("[model] file", str(exc))
+        fail("[model] file", str(exc).removeprefix("load_model: "))
     params = dict(model.params)
     for key, val in raw["model"].get("params", {}).items():
         if key not in params:

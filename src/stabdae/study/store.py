@@ -24,6 +24,8 @@ import io
 import json
 import math
 import os
+import re
+import stat
 import time
 from pathlib import Path
 
@@ -52,26 +54,68 @@ def _flush_seconds() -> float:
     return value
 
 
+#: the only names a chunk can have: :meth:`Store.flush` makes them, and a manifest's
+#: entry of any other name (``../notes.txt``, an absolute path) is not a chunk
+CHUNK_NAME = re.compile(r"chunk-(0|[1-9][0-9]{0,17})\.npz")
+
+
+def regular_file(path: Path) -> bool:
+    """Whether ``path`` is a regular file itself (not a link, a FIFO, a device or a
+    folder): the only kind of file a parts folder is read from or removed from.  A link
+    could lead out of the folder; a FIFO would block the run on its first read."""
+    try:
+        return stat.S_ISREG(os.lstat(path).st_mode)
+    except OSError:
+        return False
+
+
+def file_kind(path: Path) -> str:
+    """What ``path`` is, in words, for a message."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return "missing"
+    for test, word in ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISFIFO, "a FIFO"),
+                       (stat.S_ISDIR, "a folder"), (stat.S_ISSOCK, "a socket"),
+                       (stat.S_ISCHR, "a device"), (stat.S_ISBLK, "a device")):  # fmt: skip
+        if test(mode):
+            return word
+    return "a regular file" if stat.S_ISREG(mode) else "not a regular file"
+
+
 class Manifest:
     """``OUTPUT.parts/study.json``: the run key, the study file (resolved) and, for every
     chunk written, its SHA-256 and grid points, so that a chunk altered afterwards is
-    computed again.  Only the process that runs the study writes it."""
+    computed again.  Only the process that runs the study writes it.
+
+    A manifest is read as data: an entry whose name is not one :meth:`Store.flush`
+    makes (:data:`CHUNK_NAME`) is left out, and said in ``refused``, so that no name in
+    it can lead outside the folder."""
 
     NAME = "study.json"
 
-    def __init__(self, parts: Path, fingerprint: str, study: str, chunks=None):
+    def __init__(self, parts: Path, fingerprint: str, study: str, chunks=None, refused=()):
         self.parts, self.fingerprint, self.study = parts, fingerprint, study
         self.chunks = dict(chunks or {})
+        self.refused = list(refused)
 
     @classmethod
     def read(cls, parts: Path):
-        """The manifest in ``parts``, or None when there is none a stabdae run wrote."""
+        """The manifest in ``parts``, or None when there is none a stabdae run wrote (or
+        ``study.json`` is not a regular file)."""
+        path = parts / cls.NAME
+        if not regular_file(path):
+            return None
         try:
-            raw = json.loads((parts / cls.NAME).read_text())
-            chunks = {str(k): {"sha256": str(v["sha256"]),
-                               "points": [int(i) for i in v["points"]]}
-                      for k, v in raw.get("chunks", {}).items()}  # fmt: skip
-            return cls(parts, str(raw["fingerprint"]), str(raw["study"]), chunks)
+            raw = json.loads(path.read_text())
+            chunks, refused = {}, []
+            for k, v in raw.get("chunks", {}).items():
+                if not (isinstance(k, str) and CHUNK_NAME.fullmatch(k)):
+                    refused.append(repr(k)[:80])
+                    continue
+                chunks[k] = {"sha256": str(v["sha256"]),
+                             "points": [int(i) for i in v["points"]]}  # fmt: skip
+            return cls(parts, str(raw["fingerprint"]), str(raw["study"]), chunks, refused)
         except (OSError, ValueError, KeyError, TypeError, AttributeError):
             return None
 
@@ -90,11 +134,11 @@ _OURS = ("chunk-*.npz", ".chunk-*.tmp", Manifest.NAME, f".{Manifest.NAME}.tmp", 
 
 
 def clear(parts: Path) -> None:
-    """Remove what stabdae wrote in ``parts`` (its chunks, manifest and temporary files),
-    nothing else."""
+    """Remove what stabdae wrote in ``parts`` (its chunks, manifest and temporary files:
+    regular files of those names), nothing else."""
     for pattern in _OURS:
         for path in parts.glob(pattern):
-            if path.is_file():
+            if regular_file(path):
                 path.unlink()
 
 
@@ -117,14 +161,24 @@ class Store:
         file the manifest does not record (written when a kill came before the
         manifest)."""
         parts = self.manifest.parts
+        for name in self.manifest.refused:
+            log(f"{parts / Manifest.NAME}: the entry {name} is not the name of a chunk a "
+                "run writes: ignored (nothing of that name is opened or removed)")  # fmt: skip
         for path in parts.glob("chunk-*.npz"):
-            if path.name not in self.manifest.chunks:
+            if path.name not in self.manifest.chunks and regular_file(path):
                 path.unlink()
         for name, entry in sorted(self.manifest.chunks.items()):
             path = parts / name
             why = None
-            if not path.exists():
+            if not os.path.lexists(path):
                 why = "is missing"
+            elif not regular_file(path):
+                # never opened, never removed: a link may lead anywhere, a FIFO blocks
+                points = ", ".join(map(str, entry["points"]))
+                log(f"grid points {points}: {path} is {file_kind(path)}, not a chunk a run "
+                    "writes: left as it is, and its points computed again")  # fmt: skip
+                del self.manifest.chunks[name]
+                continue
             elif file_sha256(path) != entry["sha256"]:
                 why = "does not match its recorded checksum"
             else:
@@ -163,8 +217,10 @@ class Store:
             np.savez(buffer, **_pack({i: self.tables[i] for i in points},
                                      self.manifest.fingerprint))  # fmt: skip
             data = buffer.getvalue()
-            name = f"chunk-{self._next}.npz"
             parts = self.manifest.parts
+            while os.path.lexists(parts / f"chunk-{self._next}.npz"):  # one left alone
+                self._next += 1
+            name = f"chunk-{self._next}.npz"
             tmp = parts / f".{name}.tmp"
             tmp.write_bytes(data)
             os.replace(tmp, parts / name)

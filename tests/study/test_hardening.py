@@ -1,0 +1,195 @@
+"""A study file and a parts folder are data: neither makes stabdae import, open or delete
+a file that the user did not name, and a half-edited study never mixes into a run."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+import stabdae
+from stabdae.study.cli import main
+from stabdae.study.run import run_study
+from stabdae.study.spec import StudyError, load_study
+
+STUDY = """
+[model]
+file = "{file}"
+
+[law]
+kind = "baumgarte"
+omega = 10.0
+xi = 1.0
+
+[run]
+t_end = 0.05
+tau = 1e-2
+save_dt = 0.05
+
+[ensemble]
+members = 4
+radius = [1e-6, 1e-3]
+seed = 1
+block = 4
+
+[sweep]
+tau = [1e-2, 5e-3]
+"""
+
+
+def study_file(folder: Path, file="pendulum", name="study.toml") -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / name
+    path.write_text(textwrap.dedent(STUDY.format(file=file)))
+    return path
+
+
+# ------------------------------------------------------------------ [model] file
+def _tripwire(folder: Path) -> tuple[Path, Path]:
+    """A Python file without ``.py`` in its import name's reach, which leaves a mark when
+    it runs: (the file's path without its suffix, the mark)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    mark = folder / "ran"
+    code = folder / "evil.py"
+    code.write_text(f"open({str(mark)!r}, 'w').write('ran')\n")
+    return folder / "evil", mark
+
+
+@pytest.mark.parametrize("form", ["absolute", "relative", "dotted"])
+def test_a_scene_name_in_a_study_file_is_a_name_never_a_path(tmp_path, capsys, form):
+    """The extension-less form of ``[model] file`` names a built-in scene; a path in it
+    (absolute, or climbing out of the scenes folder) was joined onto the scenes folder and
+    imported: the file ran from ``theory`` and ``run``.  Now it is refused, names the key,
+    and nothing runs."""
+    stem, mark = _tripwire(tmp_path / "elsewhere")
+    scenes = stabdae._loading.scene_dir()
+    given = {"absolute": str(stem),
+             "relative": os.path.relpath(stem, scenes),
+             "dotted": "../" * 12 + str(stem).lstrip("/")}[form]  # fmt: skip
+    path = study_file(tmp_path / "home", given)
+    with pytest.raises(StudyError, match=r"\[model\] file: .* built-in scene \(a scene is "
+                                         r"given by its name alone\)"):
+        load_study(path)
+    assert main(["theory", str(path)]) == 2
+    assert main(["run", str(path), "-o", str(tmp_path / "out.nc")]) == 2
+    err = capsys.readouterr().err
+    assert "[model] file" in err and "Traceback" not in err
+    assert not mark.exists(), "the file named as a scene ran"
+
+
+def test_load_model_takes_a_scene_by_its_name_alone(tmp_path):
+    stem, mark = _tripwire(tmp_path)
+    with pytest.raises(stabdae.ModelError, match="load_model: .* given by its name alone"):
+        stabdae.load_model(os.path.relpath(stem, stabdae._loading.scene_dir()))
+    assert not mark.exists()
+    assert stabdae.load_model("pendulum").name == "pendulum"
+
+
+# ------------------------------------------------------------------ the parts folder
+@pytest.fixture
+def no_hang():
+    """A read that blocks (a FIFO opened) fails the test instead of hanging it."""
+    import signal
+
+    def stop(*_):
+        raise TimeoutError("blocked on a file of the parts folder")
+
+    old = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(30)
+    yield
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, old)
+
+
+def test_a_manifest_names_only_chunks_inside_its_folder(tmp_path, no_hang):
+    """A ``study.json`` with the right run key (anyone can compute it) listed
+    ``../notes.txt`` and an absolute path with wrong checksums: resuming removed both.  A
+    FIFO under a chunk's name hung the run.  Now names other than a chunk's are ignored
+    with a message, a chunk that is not a regular file is neither opened nor removed, and
+    its points are computed again."""
+    from stabdae.study.store import Manifest, Store
+
+    parts = tmp_path / "out.nc.parts"
+    parts.mkdir()
+    notes = tmp_path / "notes.txt"
+    notes.write_text("a week of notes")
+    far = tmp_path / "far"
+    far.mkdir()
+    absolute = far / "data.bin"
+    absolute.write_text("not ours")
+    os.mkfifo(parts / "chunk-1.npz")
+    (parts / "chunk-2.npz").symlink_to(absolute)
+    (parts / "chunk-7.npz").symlink_to(far / "unrecorded")  # a link no entry records
+    (far / "unrecorded").write_text("not ours either")
+    wrong = "0" * 64
+    (parts / "study.json").write_text(json.dumps({
+        "fingerprint": "key", "study": "study.toml",
+        "chunks": {"../notes.txt": {"sha256": wrong, "points": [0]},
+                   str(absolute): {"sha256": wrong, "points": [0]},
+                   "chunk-1.npz": {"sha256": wrong, "points": [1]},
+                   "chunk-2.npz": {"sha256": wrong, "points": [2]},
+                   "chunk-03.npz": {"sha256": wrong, "points": [3]}}}))  # fmt: skip
+    manifest = Manifest.read(parts)
+    assert sorted(manifest.chunks) == ["chunk-1.npz", "chunk-2.npz"]
+    said = []
+    store = Store(manifest)
+    store.resume(4, said.append)
+    text = "\n".join(said)
+    for name in ("'../notes.txt'", repr(str(absolute)), "'chunk-03.npz'"):
+        assert f"the entry {name} is not the name of a chunk a run writes: ignored" in text
+    assert f"grid points 1: {parts / 'chunk-1.npz'} is a FIFO" in text
+    assert f"grid points 2: {parts / 'chunk-2.npz'} is a symbolic link" in text
+    assert store.tables == {} and manifest.chunks == {}
+    assert notes.read_text() == "a week of notes" and absolute.read_text() == "not ours"
+    assert (far / "unrecorded").read_text() == "not ours either"
+    assert os.path.lexists(parts / "chunk-1.npz") and (parts / "chunk-2.npz").is_symlink()
+    assert (parts / "chunk-7.npz").is_symlink()
+
+
+def test_clear_removes_regular_files_of_its_own_names_only(tmp_path):
+    from stabdae.study.store import clear
+
+    parts = tmp_path / "p.parts"
+    parts.mkdir()
+    (parts / "chunk-0.npz").write_bytes(b"ours")
+    target = tmp_path / "target"
+    target.write_text("theirs")
+    (parts / "chunk-1.npz").symlink_to(target)
+    os.mkfifo(parts / "chunk-2.npz")
+    (parts / "keep.txt").write_text("theirs")
+    clear(parts)
+    assert sorted(p.name for p in parts.iterdir()) == ["chunk-1.npz", "chunk-2.npz",
+                                                        "keep.txt"]  # fmt: skip
+    assert target.read_text() == "theirs"
+
+
+@pytest.mark.parametrize("kind", ["link", "file", "fifo"])
+def test_a_parts_folder_that_is_not_a_folder_is_refused_before_computing(tmp_path, kind):
+    """A parts folder that was a symbolic link had the dataset written, then the run
+    exited 2 with ``Not a directory``; now the run is refused before any grid point, the
+    link (file, FIFO) left as it is."""
+    study = study_file(tmp_path, name="s.toml")
+    parts = tmp_path / "out.nc.parts"
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    {"link": lambda: parts.symlink_to(elsewhere), "file": lambda: parts.write_text("x"),
+     "fifo": lambda: os.mkfifo(parts)}[kind]()  # fmt: skip
+    with pytest.raises(FileExistsError, match=r"out\.nc\.parts is (a symbolic link|a regular "
+                                              r"file|a FIFO), not a folder of a run's parts"):
+        run_study(study, tmp_path / "out.nc", progress=False, log=lambda *a: None)
+    assert not (tmp_path / "out.nc").exists() and os.path.lexists(parts)
+    assert list(elsewhere.iterdir()) == []
+
+
+def test_a_lock_that_is_not_a_file_is_refused_not_read(tmp_path, no_hang):
+    from stabdae.study.run import _lock
+
+    parts = tmp_path / "p.parts"
+    parts.mkdir()
+    os.mkfifo(parts / "lock")
+    with pytest.raises(FileExistsError, match=r"lock is a FIFO, not the lock a run writes"):
+        _lock(parts)
