@@ -132,7 +132,13 @@ def load_model(source, attribute: str = "model") -> Model:
     (2, 1)
     """
     path = model_file(source)
-    name = module_name(path)
+    return load_as(path, module_name(path), attribute)
+
+
+def load_as(path: Path, name: str, attribute: str = "model") -> Model:
+    """The model of the file ``path`` loaded as the module ``name`` (:func:`load_model`
+    chooses the name; a dask worker gives the one the process that runs the study
+    chose, so that the model's functions have the same fingerprints there)."""
     module = sys.modules.get(name)
     stamp = getattr(module, "__stabdae_sources__", None)
     if module is not None and stamp is not None and _sources_changed(stamp):
@@ -169,6 +175,7 @@ def load_model(source, attribute: str = "model") -> Model:
         )
     # where another process finds the same model (a helper compiling its sampler ahead)
     model._origin = (str(path), attribute)
+    model._module = name  # the name it is loaded under (a dask worker loads it so too)
     return model
 
 

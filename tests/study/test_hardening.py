@@ -16,6 +16,10 @@ from stabdae.study.cli import main
 from stabdae.study.run import run_study
 from stabdae.study.spec import StudyError, load_study
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from conftest import same_data  # noqa: E402
+from conftest import study_file as shared_study  # noqa: E402
+
 STUDY = """
 [model]
 file = "{file}"
@@ -193,3 +197,53 @@ def test_a_lock_that_is_not_a_file_is_refused_not_read(tmp_path, no_hang):
     os.mkfifo(parts / "lock")
     with pytest.raises(FileExistsError, match=r"lock is a FIFO, not the lock a run writes"):
         _lock(parts)
+
+
+# ------------------------------------------------------------------ distributed runs
+def test_an_edit_of_the_study_file_during_a_dask_run_changes_nothing(tmp_path, monkeypatch):
+    """Each worker re-read the study file per grid point: ``seed`` edited after the first
+    point gave points of both seeds, exit 0, and the conflicting attribute dropped.  The
+    parsed study is shipped once now; the run is the study as it was read."""
+    pytest.importorskip("distributed")
+    import xarray as xr
+
+    from stabdae.study import store
+
+    model = tmp_path / "home" / "pend.py"
+    model.parent.mkdir()
+    model.write_text((Path(__file__).resolve().parents[2] / "kernels" / "pendulum.py")
+                     .read_text())  # fmt: skip
+    path = shared_study(tmp_path / "home", members=16, t_end=0.2, omegas="5.0")
+    path.write_text(path.read_text().replace('file = "pendulum"', 'file = "pend.py"'))
+    clean = run_study(path, tmp_path / "clean.nc", progress=False, log=lambda *a: None)
+    real_add, edited = store.Store.add, []
+
+    def add_then_edit(self, index, table):
+        real_add(self, index, table)
+        if not edited:  # after the first point: the seed, and the model file itself
+            path.write_text(path.read_text().replace("seed = 3", "seed = 99"))
+            model.write_text(model.read_text().replace("9.81", "1.62"))
+            edited.append(index)
+
+    monkeypatch.setattr(store.Store, "add", add_then_edit)
+    out = run_study(path, tmp_path / "dask.nc", workers=2, progress=False,
+                    log=lambda *a: None)  # fmt: skip
+    assert edited
+    ds = xr.open_dataset(out).load()
+    assert ds.attrs["seed"] == 3
+    same_data(ds, xr.open_dataset(clean).load())
+
+
+def test_a_worker_result_under_another_run_key_is_refused(tmp_path, monkeypatch):
+    """The run key is checked on every result a worker returns."""
+    pytest.importorskip("distributed")
+    import stabdae.study.run as runner
+
+    path = shared_study(tmp_path, members=16, t_end=0.2, omegas="5.0")
+    # this process's key differs from the one the worker computes (as when the worker's
+    # library or numba differ)
+    monkeypatch.setattr(runner, "_fingerprint", lambda study: "f" * 64)
+    with pytest.raises(StudyError, match=r"a dask worker computed grid point \d+ under "
+                                         r"another run key"):
+        run_study(path, tmp_path / "x.nc", workers=1, progress=False, log=lambda *a: None)
+    assert not (tmp_path / "x.nc").exists()

@@ -13,6 +13,7 @@ point ran (in-process, or on dask workers), so the dataset is the same either wa
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -116,7 +117,7 @@ def _fingerprint(study: Study) -> str:
     the model file and the modules of its folder that it imports, the model's functions
     with the helpers and values they read (wherever those live), and the library (its
     source, numba's version, FMA)."""
-    h = hashlib.sha256(study.path.read_bytes())
+    h = hashlib.sha256(study.text)
     h.update(json.dumps(study.ensemble, sort_keys=True).encode())
     h.update(__version__.encode())
     h.update(library_fingerprint().encode())
@@ -288,7 +289,7 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
     finished = False
     try:
         if workers or scheduler:
-            _run_dask(study, todo, done, workers, scheduler)
+            _run_dask(study, todo, done, workers, scheduler, manifest.fingerprint)
         else:
             for i, values in todo:
                 report = bar.note if study.search is not None else bar.members
@@ -332,7 +333,7 @@ def _with_path_theory(study: Study, ds: xr.Dataset) -> xr.Dataset:
     return ds.assign({v: th[v].assign_coords({d: ds[d] for d in th[v].dims}) for v in keep})
 
 
-def _run_dask(study, todo, done, workers, scheduler):
+def _run_dask(study, todo, done, workers, scheduler, stamp):
     from dask.distributed import Client, LocalCluster, as_completed
 
     if scheduler:
@@ -346,22 +347,87 @@ def _run_dask(study, todo, done, workers, scheduler):
                                processes=True, dashboard_address=None)  # fmt: skip
         client = Client(cluster)
     try:
-        # an absolute path: the workers may run in another folder
-        path, members = str(study.path.resolve()), study.ensemble["members"]
-        futures = {client.submit(_remote_point, path, members, values, pure=False): i
+        # the study as this process read and accepted it, sent once to every worker: a
+        # worker never reads the study file (an edit during the run would mix versions)
+        shipped = client.scatter(shipment(study, stamp), broadcast=True)
+        futures = {client.submit(_remote_point, shipped, values, pure=False): i
                    for i, values in todo}  # fmt: skip
         for fut in as_completed(futures):
-            done(futures[fut], fut.result())
+            key, table = fut.result()
+            if key != stamp:
+                raise StudyError(
+                    f"stabdae run: a dask worker computed grid point {futures[fut]} under "
+                    f"another run key ({key[:12]}…, this run's {stamp[:12]}…): its stabdae, "
+                    "numba or the model's helpers differ from this process's; its result is "
+                    "not used (the grid points done so far are kept)"
+                )
+            done(futures[fut], table)
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
 
 
-def _remote_point(path, members, values):
-    # the process that runs the study has loaded and accepted its model already
-    study = load_study(path, members=members, trust_model=True)
-    return run_point(study, values, threads=1)
+def shipment(study: Study, stamp: str) -> dict:
+    """What a dask worker needs to run the study's grid points: the parsed study (without
+    its model), the run key, and the model: a built-in scene by name, a model file by the
+    bytes of it and of the modules of its folder it imports, with the module name this
+    process loaded it under."""
+    model_file = study.model_file
+    files, scene = {}, None
+    from .._loading import scene_dir
+
+    if model_file is not None and model_file.parent == scene_dir().resolve():
+        scene = model_file.stem
+    elif model_file is not None:
+        home = model_file.parent
+        for path in local_imports(model_file):
+            try:
+                files[path.relative_to(home).as_posix()] = path.read_bytes()
+            except ValueError:  # outside its folder: the worker finds it as this one does
+                continue
+    origin = getattr(study.model, "_origin", None)
+    module = getattr(study.model, "_module", None)
+    return {"study": dataclasses.replace(study, model=None), "key": stamp, "scene": scene,
+            "files": files, "main": None if model_file is None else model_file.name,
+            "module": module, "attribute": origin[1] if origin else "model"}  # fmt: skip
+
+
+#: the studies a worker process has loaded, by run key (each worker loads one once)
+_LOADED: dict = {}
+
+
+def _remote_point(shipped: dict, values: dict):
+    """One grid point on a dask worker: ``(the worker's run key, table)``."""
+    key = shipped["key"]
+    if key not in _LOADED:
+        _LOADED[key] = _worker_study(shipped)
+    study, worker_key = _LOADED[key]
+    return worker_key, run_point(study, values, threads=1)
+
+
+def _worker_study(shipped: dict):
+    """The shipped study with its model loaded here (a scene by name; a model file from
+    the shipped bytes, written to a folder of this process's), and its run key as this
+    worker computes it."""
+    import tempfile
+
+    from .._loading import load_as, load_model
+
+    study = shipped["study"]
+    if shipped["scene"] is not None:
+        model = load_model(shipped["scene"])
+        model_file = study.model_file
+    else:
+        home = Path(tempfile.mkdtemp(prefix="stabdae-worker-"))
+        for name, data in shipped["files"].items():
+            target = home.joinpath(*name.split("/"))
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
+        model_file = home / shipped["main"]
+        model = load_as(model_file, shipped["module"], shipped["attribute"])
+    study = dataclasses.replace(study, model=model, model_file=model_file)
+    return study, _fingerprint(study)
 
 
 def combine(study: Study, tables: list[Table]) -> xr.Dataset:

@@ -82,6 +82,9 @@ class Study:
     #: why ``output`` may not be written (it lies outside the study's folder and the
     #: current one), or None
     output_refused: str | None = None
+    #: the study file's bytes as read and validated: the run key is made of them, not of
+    #: the file as it may be by the time a grid point runs
+    text: bytes = b""
 
     # ----------------------------------------------------------------- grid
     @property
@@ -198,9 +201,16 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
     if not path.is_file():
         raise StudyError(f"{path}: no such study file")
     try:
-        raw = tomllib.loads(path.read_text())
+        text = path.read_bytes()
+        raw = tomllib.loads(text.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise StudyError(f"{path}: not a text file in UTF-8 (byte {exc.start} is "
+                         f"{text[exc.start:exc.start + 1]!r}); a study file is TOML, which is "
+                         "UTF-8") from None  # fmt: skip
     except tomllib.TOMLDecodeError as exc:
         raise StudyError(f"{where}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise StudyError(f"{where}: not valid TOML: nested too deeply") from None
 
     def fail(key: str, msg: str):
         raise StudyError(f"{where}: {key}: {msg}")
@@ -391,7 +401,7 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
                   output=None if output is None
                   else Path(os.path.normpath(path.parent / output)),
                   model_file=model_file(source), notes=notes, search=search,
-                  output_refused=refused)  # fmt: skip
+                  output_refused=refused, text=text)  # fmt: skip
     if searching:
         return study  # τ is what the search finds: no time grid to check
 
