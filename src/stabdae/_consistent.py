@@ -17,6 +17,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
+import math
+import warnings
+
 import numpy as np
 
 if TYPE_CHECKING:  # the model module imports this one
@@ -60,6 +63,9 @@ def consistent_state(model: Model, fixed=None, *, guess=None, params=None, t=Non
         residuals).
     """
     who = f"{model.name}.consistent_state"
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)) \
+            or not (math.isfinite(tol) and tol > 0):  # NaN compared false: nothing refused
+        raise ValueError(f"{who}: tol must be a positive finite number, got {tol!r}")
     n = model.n
     p = model.param_vector(params)
     t = model.t0 if t is None else float(t)
@@ -119,7 +125,7 @@ def _held(model: Model, fixed, who: str) -> dict[int, float]:
         raise ValueError(f"{who}: fixed must be a mapping of state components (names or "
                          f"indices) to values, got {type(fixed).__name__}")  # fmt: skip
     names = model.state_names
-    out = {}
+    out, given = {}, {}
     for key, value in fixed.items():
         if isinstance(key, str):
             if key not in names:
@@ -132,6 +138,10 @@ def _held(model: Model, fixed, who: str) -> dict[int, float]:
         else:
             raise ValueError(f"{who}: {key!r} is not a state component (a name of "
                              f"model.state_names or an index 0 … {2 * model.n - 1})")  # fmt: skip
+        if i in out:
+            raise ValueError(f"{who}: {names[i]} is held twice, as {given[i]!r} = "
+                             f"{out[i]!r} and as {key!r} = {value!r}: give it once")  # fmt: skip
+        given[i] = key
         value = float(value)
         if not np.isfinite(value):
             raise ValueError(f"{who}: the value held for {names[i]} is not finite: {value}")
@@ -173,7 +183,31 @@ def _solve(x, free, system, rows, names, limit, who, what, held, columns=None):
             "they contradict the held values, or have no solution near the guess"
         )
     _determined(jac[:, columns], free, names, who, what)
+    _conditioned(jac, columns, free, names, who, what)
     return x
+
+
+#: a solution is called ill-determined (and warned of) when the constraint Jacobian in the
+#: unknowns solved for has a singular value below this fraction of the whole Jacobian's
+#: largest: an error of δ in a held value or a constraint then moves it by δ / that
+#: fraction or more (a mechanism at or next to a singular configuration)
+ILL_CONDITIONED = 1e-6
+
+
+def _conditioned(jac, columns, free, names, who, what):
+    """Warn when the solution for ``free`` is ill-determined (:data:`ILL_CONDITIONED`)."""
+    if not free or not jac.size:
+        return
+    whole = float(np.linalg.norm(jac, 2))
+    small = float(np.linalg.svd(jac[:, columns], compute_uv=False)[-1])
+    if whole > 0 and small < ILL_CONDITIONED * whole:
+        warnings.warn(
+            f"{who}: the constraints barely determine the {what} solved for "
+            f"({', '.join(names[i] for i in free)}): the smallest singular value of their "
+            f"Jacobian in them is {small:.2g}, {small / whole:.1e} of the largest: a "
+            "singular configuration, where a small change of the held values moves the "
+            "solution far; hold other components, or move away from it",
+            RuntimeWarning, stacklevel=5)  # fmt: skip
 
 
 def _determined(J, free, names, who, what):

@@ -4,10 +4,12 @@ under-determined and contradictory choices refused with the names that matter.""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 
+import stabdae
 from conftest import load_scene
 
 
@@ -75,3 +77,37 @@ def test_the_guess_picks_the_branch():
     pend = load_scene("pendulum")
     x = pend.consistent_state({"x": 0.3, "x_dot": 0.0}, guess=[0.0, 1.0, 0.0, 0.0])
     assert x[1] == pytest.approx(math.sqrt(1 - 0.09), rel=1e-15)
+
+
+@pytest.mark.parametrize("tol", [float("nan"), -1.0, 0.0, float("inf"), "1e-3", True])
+def test_a_tolerance_that_is_not_a_positive_number_is_refused(tol):
+    """``tol=nan`` returned a state that breaks the constraint (every comparison with NaN
+    is false, so nothing was refused)."""
+    model = stabdae.load_model("pendulum")
+    with pytest.raises(ValueError, match=r"pendulum\.consistent_state: tol must be a "
+                                         r"positive finite number"):
+        model.consistent_state({"x": 0.3, "x_dot": 1.0}, tol=tol)
+
+
+def test_a_component_held_by_name_and_by_index_is_refused():
+    """``{"x": 0.3, 0: 0.4}`` kept 0.4 without a word."""
+    model = stabdae.load_model("pendulum")
+    with pytest.raises(ValueError, match=r"x is held twice, as 'x' = 0\.3 and as 0 = 0\.4"):
+        model.consistent_state({"x": 0.3, 0: 0.4, "x_dot": 1.0})
+
+
+def test_a_singular_configuration_is_warned_of_and_a_regular_one_is_not():
+    """Holding the pendulum's x at its length leaves y at the double root of x² + y² = 1:
+    the velocity ẏ = −x ẋ / y solved there was 10⁷ m/s without a warning.  A state
+    away from it solves silently."""
+    model = stabdae.load_model("pendulum")
+    with pytest.warns(RuntimeWarning) as record:
+        x = model.consistent_state({"x": 1.0, "x_dot": 1.0})
+    said = [str(w.message) for w in record]
+    assert any("barely determine the coordinates solved for (y)" in m for m in said), said
+    assert any("barely determine the velocities solved for (y_dot)" in m for m in said), said
+    assert abs(x[3]) > 1e5  # what it solved is the sensitive solution it warns of
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        x = model.consistent_state({"x": 0.3, "x_dot": 1.0})
+    np.testing.assert_allclose(x[0] * x[2] + x[1] * x[3], 0.0, atol=1e-12)
