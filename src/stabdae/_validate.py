@@ -222,7 +222,14 @@ def seed(value, who: str) -> int:
         )
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
         raise ValueError(f"{who}: seed must be a non-negative integer, got {value!r}")
+    if value > MAX_SEED:  # the dataset's attribute is a 64-bit integer
+        raise ValueError(f"{who}: seed must be at most 2**64 - 1 = {MAX_SEED} (the dataset "
+                         f"stores it as a 64-bit integer), got {value}")  # fmt: skip
     return int(value)
+
+
+#: the largest seed: the dataset's ``seed`` attribute is an unsigned 64-bit integer
+MAX_SEED = 2**64 - 1
 
 
 def choice(value, name: str, options, who: str):

@@ -247,3 +247,18 @@ def test_a_worker_result_under_another_run_key_is_refused(tmp_path, monkeypatch)
                                          r"another run key"):
         run_study(path, tmp_path / "x.nc", workers=1, progress=False, log=lambda *a: None)
     assert not (tmp_path / "x.nc").exists()
+
+
+# ------------------------------------------------------------------ values out of range
+def test_a_seed_the_dataset_cannot_store_is_refused_before_any_point(tmp_path):
+    """A seed of 2**64 passed validation, then failed after every grid point was computed
+    (``illegal data type for attribute b'seed'``), and every resume failed the same."""
+    path = study_file(tmp_path)
+    path.write_text(path.read_text().replace("seed = 1", f"seed = {2**64}"))
+    with pytest.raises(StudyError, match=r"\[ensemble\] seed: must be at most 2\*\*64 - 1"):
+        load_study(path)
+    path.write_text(path.read_text().replace(f"seed = {2**64}", f"seed = {2**64 - 1}"))
+    assert load_study(path).ensemble["seed"] == 2**64 - 1
+    model = stabdae.load_model("pendulum")
+    with pytest.raises(ValueError, match=r"sample_perturbations: seed must be at most"):
+        stabdae.sample_perturbations(model, 4, seed=2**64)

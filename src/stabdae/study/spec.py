@@ -25,7 +25,7 @@ from .._loading import load_model, model_file
 from .._model import Model, ModelError
 from .._schemes import Scheme, SchemeError, as_scheme, from_tableau
 from .._sequential import Sequential
-from .._validate import block, ensemble_bytes, fits_in_memory, fixed_time_grid
+from .._validate import block, ensemble_bytes, fits_in_memory, fixed_time_grid, seed
 
 __all__ = ["Study", "StudyError", "load_study"]
 
@@ -334,8 +334,10 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
     if not (0 < radius[0] <= radius[1] and math.isfinite(radius[1])):
         fail("[ensemble] radius", f"needs 0 < low <= high, got {radius}")
     ens["radius"] = radius
-    if ens["seed"] < 0:
-        fail("[ensemble] seed", f"must be a non-negative integer, got {ens['seed']}")
+    try:
+        seed(ens["seed"], "study")
+    except ValueError as exc:
+        fail("[ensemble] seed", str(exc).removeprefix("study: seed "))
     try:
         block(ens["block"], model.n, "study", "block")
     except ValueError as exc:
