@@ -9,7 +9,13 @@ below it: :mod:`stabdae.engine` (compiled), the drivers and definitions here,
 """
 
 # _vector_width first: numba's CPU features are fixed by the first compiled function
-from . import _vector_width, theory  # noqa: F401
+from . import _vector_width  # noqa: F401, I001
+from .engine.checked_cache import checked_library_caches
+
+# before any module of the library decorates a function with cache=True
+checked_library_caches()
+
+from . import theory  # noqa: E402, F401
 from ._adaptive import integrate_adaptive
 from ._boundary import boundary
 from ._codes import Status

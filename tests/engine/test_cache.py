@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import pickle
 import subprocess
 import sys
 import textwrap
@@ -653,3 +654,66 @@ def test_an_internal_function_is_compiled_for_its_callers_only(capfd):
         return x
 
     assert type(cached._compiler) is not type(quiet._compiler)
+
+
+class _Mark:
+    """Unpickled, it creates a file: what a crafted cache index could do."""
+
+    def __init__(self, path):
+        self.path = str(path)
+
+    def __reduce__(self):
+        return (os.system, (f"touch {self.path}",))
+
+
+POWERS = (
+    "import json, warnings\n"
+    "import numpy as np\n"
+    "from stabdae import theory\n"
+    "with warnings.catch_warnings(record=True) as caught:\n"
+    "    warnings.simplefilter('always')\n"
+    "    out = theory.power_norms(np.array([[0.5, 1.0], [0.0, 0.25]]))\n"
+    "print(json.dumps({'x': list(out), 'warnings': [str(w.message) for w in caught]}))\n"
+)
+
+
+def test_the_librarys_numba_cache_is_data_damaged_or_crafted(tmp_path):
+    """The library's own ``@njit(cache=True)`` functions in numba's cache folder: entries
+    overwritten gave ``_pickle.UnpicklingError`` on every later run (``theory``'s walk over
+    the powers of R); an index is no longer a pickle, so a crafted one runs nothing.  Each
+    damaged file is named in one warning, compiled again, and the next run is silent with
+    the same numbers."""
+    cache = tmp_path / "numba"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(SRC),
+               STABDAE_CACHE_DIR="off")  # fmt: skip
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", POWERS], env=env, capture_output=True,
+                             text=True, timeout=300)  # fmt: skip
+        assert out.returncode == 0, out.stderr[-3000:]
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    first = run()
+    walk = sorted(cache.rglob("theory._power_walk*.nbc")) + \
+        sorted(cache.rglob("theory._power_walk*.nbi"))  # fmt: skip
+    assert len(walk) == 2, sorted(cache.rglob("theory.*"))
+    for path in walk:  # a pickle that would leave a mark if unpickled
+        path.write_bytes(b"not a pickle")
+    data, index = walk
+    again = run()
+    assert again["x"] == first["x"]
+    assert run()["warnings"] == []
+    mark = tmp_path / "ran"
+    index.write_bytes(pickle.dumps(_Mark(mark)))  # numba's own index format: a pickle
+    assert run()["x"] == first["x"] and not mark.exists()
+    text = index.read_bytes()
+    assert text.startswith(b"stabdae kernel cache index 1\n"), text[:80]
+    index.write_bytes(text[: len(text) // 2])  # ours, cut short: named, then replaced
+    said = run()
+    assert said["x"] == first["x"]
+    assert any(f"the cache index {index} is damaged" in w for w in said["warnings"]), said
+    data.write_bytes(b"stabdae kernel cache entry 2\n" + b"x" * 100)
+    said = run()
+    assert said["x"] == first["x"]
+    assert any(f"the cache entry {data} does not match" in w for w in said["warnings"]), said
+    assert run()["warnings"] == []

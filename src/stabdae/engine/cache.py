@@ -32,7 +32,6 @@ import dataclasses
 import hashlib
 import inspect
 import os
-import pickle
 import shutil
 import sys
 import types
@@ -44,18 +43,13 @@ from pathlib import Path
 import numba
 import numpy as np
 
-try:  # numba's caching classes are private: without them kernels compile in memory
-    from numba.core.caching import (
-        CompileResultCacheImpl,
-        FunctionCache,
-        IndexDataCacheFile,
-        _CacheLocator,
-    )
-except ImportError:  # pragma: no cover - exercised by a test that hides the module
-    CompileResultCacheImpl = FunctionCache = IndexDataCacheFile = _CacheLocator = object
-    CACHING_API = False
-else:
-    CACHING_API = True
+from .checked_cache import (
+    CACHING_API,
+    CompileResultCacheImpl,
+    FunctionCache,
+    _CacheLocator,
+    _CheckedCacheFile,
+)
 
 from .fma import HOST_FMA
 from .jit import JIT
@@ -310,42 +304,6 @@ class _KeyedImpl(CompileResultCacheImpl):
         self._filename_base = self.get_filename_base(fullname, getattr(sys, "abiflags", ""))
 
 
-class _CheckedCacheFile(IndexDataCacheFile):
-    """numba's index and data files, each data file headed by what it is: the kernel's
-    key, its entry's file name and the SHA-256 of those and of the compiled code.  A data
-    file that does not match (damaged, cut short, or another kernel's swapped in) is
-    refused on load, so it is compiled again and rewritten, never run."""
-
-    _MAGIC = b"stabdae kernel cache entry 1\n"
-
-    def _digest(self, name: str, payload: bytes) -> str:
-        h = hashlib.sha256(self._source_stamp.encode())
-        h.update(b"\x00" + name.encode() + b"\x00")
-        h.update(payload)
-        return h.hexdigest()
-
-    def _save_data(self, name, data):
-        payload = self._dump(data)
-        head = f"{self._source_stamp} {name} {self._digest(name, payload)}\n".encode()
-        with self._open_for_write(self._data_path(name)) as f:
-            f.write(self._MAGIC + head + payload)
-
-    def _load_data(self, name):
-        path = self._data_path(name)
-        with open(path, "rb") as f:
-            raw = f.read()
-        head, _, payload = raw[len(self._MAGIC):].partition(b"\n")
-        want = f"{self._source_stamp} {name} {self._digest(name, payload)}".encode()
-        if not raw.startswith(self._MAGIC) or head != want:
-            raise _EntryMismatch(f"the cache entry {path} does not match its recorded key "
-                                 "and checksum (damaged, or another kernel's)")  # fmt: skip
-        return pickle.loads(payload)
-
-
-class _EntryMismatch(Exception):
-    pass
-
-
 class _KeyedCache(FunctionCache):
     """numba's function cache with an explicit key in place of the closure pickle."""
 
@@ -372,7 +330,8 @@ class _KeyedCache(FunctionCache):
             return super().load_overload(sig, target_context)
         except Exception as exc:
             _warn_once(f"a cached kernel could not be loaded ({type(exc).__name__}: {exc}); "
-                       "compiling it again")  # fmt: skip
+                       "compiling it again",
+                       key=f"{self._cache_path}/{self._impl.filename_base}")  # fmt: skip
             return None
 
     def save_overload(self, sig, data):
@@ -388,8 +347,10 @@ class _KeyedCache(FunctionCache):
 _WARNED: set[str] = set()
 
 
-def _warn_once(message: str) -> None:
-    kind = message.split(" (", 1)[0]
+def _warn_once(message: str, key: str | None = None) -> None:
+    """Warn once per ``key`` (default: the message's kind, its text before " ("): a
+    damaged entry is named once, not at every call that finds it."""
+    kind = key or message.split(" (", 1)[0]
     if kind not in _WARNED:
         _WARNED.add(kind)
         warnings.warn(f"stabdae: {message}", RuntimeWarning, stacklevel=3)
