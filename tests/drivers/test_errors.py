@@ -472,3 +472,26 @@ def test_a_crash_in_a_compiled_kernel_says_what_to_do(tmp_path):
     assert checked.returncode == 0, checked.stderr[-3000:]
     assert "IndexError" in checked.stdout and "t = " in checked.stdout, checked.stdout
     assert "q = [" in checked.stdout
+
+
+def test_heap_corruption_found_after_the_kernel_still_says_what_to_do(tmp_path):
+    """A model that writes just past its ``out`` array on the heap: glibc found the
+    corruption at a later free, after the kernel had returned, and the process died of
+    ``malloc(): unaligned tcache chunk detected`` (an abort, exit 134) or a fault with
+    nothing else said.  The message now comes however it dies."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    model_file = tmp_path / "heap_writer.py"
+    model_file.write_text(OUT_OF_BOUNDS_MODEL.replace(
+        "out[1000000000000] = 1.0", "for j in range(2, 40):\n            out[j] = 1e300"))
+    src = str(Path(stabdae.__file__).resolve().parents[1])
+    environ = dict(os.environ, PYTHONPATH=src, STABDAE_CACHE_DIR=str(tmp_path / "c"))
+    crashed = subprocess.run([sys.executable, "-c", CRASHING_RUN, str(model_file), "integrate"],
+                             env=environ, capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert crashed.returncode != 0, crashed.stdout
+    assert "stabdae: " in crashed.stderr and "integrate" in crashed.stderr, crashed.stderr
+    assert "wrote outside its arrays" in crashed.stderr and "NUMBA_BOUNDSCHECK=1" in \
+        crashed.stderr, crashed.stderr  # fmt: skip

@@ -4,11 +4,14 @@ A model function that writes outside its ``out`` array at a state that ``Model()
 ``model.check()`` did not try (they run every function as Python and bounds-checked)
 corrupts memory in a compiled kernel, or makes the process die of a segmentation fault
 with nothing said.  Checking every index in the kernels costs their speed, so the
-default runs unchecked; while a kernel called under :func:`guard` runs, a handler of
-SIGSEGV and SIGBUS writes what happened and what to do to stderr and then hands the
-signal to the handler that was there before (Python's ``faulthandler``, if enabled, then
-prints the Python stack; otherwise the process dies as before).  The process is not
-saved: the memory may already be corrupt.
+default runs unchecked; from the first kernel called under :func:`guard`, a handler of
+SIGSEGV, SIGBUS and SIGABRT writes what happened and what to do to stderr and then hands
+the signal to the handler that was there before (Python's ``faulthandler``, if enabled,
+then prints the Python stack; otherwise the process dies as before).  The process is not
+saved: the memory may already be corrupt.  A write outside an array on the heap is often
+found only later, when the C library frees a block near it and aborts ("malloc():
+unaligned tcache chunk detected"), after the kernel returned: the handler therefore stays
+after the guard, saying that a kernel ran earlier rather than that one crashed.
 
 The handler calls only ``write``, ``strlen`` and ``sigaction`` (async-signal-safe); it is a
 few lines of LLVM IR compiled by llvmlite once per process under the first guard, with the
@@ -27,14 +30,19 @@ import threading
 
 __all__ = ["guard"]
 
-_SIGNALS = (signal.SIGSEGV, signal.SIGBUS) if hasattr(signal, "SIGBUS") else (signal.SIGSEGV,)
+#: a fault, and glibc's abort when it finds its heap corrupt ("malloc(): unaligned tcache
+#: chunk detected"): a write outside an array often surfaces as the second, later
+_SIGNALS = tuple(getattr(signal, name) for name in ("SIGSEGV", "SIGBUS", "SIGABRT")
+                 if hasattr(signal, name))
 #: glibc's struct sigaction is 152 bytes on x86-64 and aarch64: room to spare
 _ACTION_BYTES = 256
 _FLAGS_OFFSET = 8 + 128  # after sa_handler and the 1024-bit sa_mask
 _SA_ONSTACK = 0x08000000
 
 _LOCK = threading.Lock()
-_state = {"depth": 0, "handler": None, "failed": False}
+#: ``lingering``: the handler stays installed after the outermost guard, with the message
+#: of :func:`_after_message` (corrupted memory is often found later, at a free)
+_state = {"depth": 0, "handler": None, "failed": False, "lingering": False}
 _MESSAGE = ctypes.create_string_buffer(4096)
 _OLD = {sig: (ctypes.c_char * _ACTION_BYTES)() for sig in _SIGNALS}
 _NEW = (ctypes.c_char * _ACTION_BYTES)()
@@ -42,9 +50,22 @@ _NEW = (ctypes.c_char * _ACTION_BYTES)()
 
 def _message(who: str) -> bytes:
     return (
-        f"\nstabdae: {who} crashed inside a compiled kernel (a segmentation fault or bus "
-        "error): most likely a model or law function read or wrote outside its arrays at a "
+        f"\nstabdae: {who} crashed inside a compiled kernel (a segmentation fault, a bus "
+        "error, or the C library's abort on corrupted memory): most likely a model or law function read or wrote outside its arrays at a "
         "state that Model() and model.check() did not try.  Run it again with "
+        "NUMBA_BOUNDSCHECK=1 in the environment: it then stops with an IndexError that "
+        "names the function, the time and the state.  (The grid points a study has "
+        "finished are kept: the same command resumes.)\n"
+    ).encode()[: len(_MESSAGE) - 1]
+
+
+def _after_message(who: str) -> bytes:
+    return (
+        f"\nstabdae: the process crashed (a segmentation fault, a bus error, or the C "
+        f"library's abort on corrupted memory) after a compiled kernel of stabdae ran in it "
+        f"({who}): if nothing else in it runs compiled code, most likely a model or law "
+        "function wrote outside its arrays at a state that Model() and model.check() did "
+        "not try, and the memory it corrupted was found later.  Run it again with "
         "NUMBA_BOUNDSCHECK=1 in the environment: it then stops with an IndexError that "
         "names the function, the time and the state.  (The grid points a study has "
         "finished are kept: the same command resumes.)\n"
@@ -107,9 +128,10 @@ def _compile_handler():
     b.call(callee("write", i64, i32, i8p, i64), [ir.Constant(i32, 2), text, length])
     sig = fn.args[0]
     # the handler before ours takes over; the faulting instruction runs again on return
-    old = b.select(b.icmp_signed("==", sig, ir.Constant(i32, int(signal.SIGSEGV))),
-                   address(ctypes.addressof(_OLD[signal.SIGSEGV])),
-                   address(ctypes.addressof(_OLD[_SIGNALS[-1]])))  # fmt: skip
+    old = address(ctypes.addressof(_OLD[_SIGNALS[-1]]))
+    for each in _SIGNALS[:-1]:
+        old = b.select(b.icmp_signed("==", sig, ir.Constant(i32, int(each))),
+                       address(ctypes.addressof(_OLD[each])), old)  # fmt: skip
     b.call(callee("sigaction", i32, i32, i8p, i8p),
            [sig, b.inttoptr(old, i8p), ir.Constant(i8p, None)])  # fmt: skip
     b.ret_void()
@@ -128,6 +150,8 @@ def _install(who: str) -> None:
         _state["handler"] = _compile_handler()
     handler, c_sigaction = _state["handler"]
     _MESSAGE.value = _message(who)
+    if _state["lingering"] and _still_ours(handler, c_sigaction):
+        return  # installed since an earlier guard: the actions saved then stay the ones before
     ctypes.memset(_NEW, 0, _ACTION_BYTES)
     ctypes.memmove(_NEW, ctypes.byref(ctypes.c_size_t(handler.address)), 8)
     flags = ctypes.c_int(_SA_ONSTACK)  # on faulthandler's stack, where it has set one up
@@ -137,10 +161,30 @@ def _install(who: str) -> None:
             raise OSError(f"sigaction({int(sig)}) failed")
 
 
+def _still_ours(handler, c_sigaction) -> bool:
+    """Whether every signal's action is still this handler (nobody replaced it since)."""
+    now = (ctypes.c_char * _ACTION_BYTES)()
+    for sig in _SIGNALS:
+        if c_sigaction(int(sig), 0, ctypes.addressof(now)) != 0:
+            return False
+        if ctypes.c_size_t.from_buffer(now).value != handler.address:
+            return False
+    return True
+
+
+def _linger(who: str) -> None:
+    """After the outermost guard: the handler stays, saying that a kernel ran earlier
+    (heap corruption is often detected only at a later free, outside any kernel)."""
+    _MESSAGE.value = _after_message(who)
+    _state["lingering"] = True
+
+
 def _restore() -> None:
+    """Put back the actions from before the first guard (for tests)."""
     _, c_sigaction = _state["handler"]
     for sig in _SIGNALS:
         c_sigaction(int(sig), ctypes.addressof(_OLD[sig]), 0)
+    _state["lingering"] = False
 
 
 @contextlib.contextmanager
@@ -168,4 +212,4 @@ def guard(who: str):
             with _LOCK:
                 _state["depth"] -= 1
                 if _state["depth"] == 0:
-                    _restore()
+                    _linger(who)
