@@ -166,6 +166,13 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
         ``report.ok`` is True when every piece agrees; ``str(report)`` is a table and
         ``report.failures`` names the pieces that disagree.
     """
+    from . import _validate as check
+
+    who = f"{model.name}.check"
+    rtol = check.positive(rtol, "rtol", who)
+    radius = check.positive(radius, "radius", who)
+    if isinstance(states, bool) or not isinstance(states, (int, np.integer)) or states < 0:
+        raise ValueError(f"{who}: states must be a non-negative integer, got {states!r}")
     p = model.param_vector(params)
     rng = np.random.default_rng(seed)
     x_ref = model.reference_state(p)

@@ -142,7 +142,11 @@ def _held(model: Model, fixed, who: str) -> dict[int, float]:
             raise ValueError(f"{who}: {names[i]} is held twice, as {given[i]!r} = "
                              f"{out[i]!r} and as {key!r} = {value!r}: give it once")  # fmt: skip
         given[i] = key
-        value = float(value)
+        try:
+            value = float(value)
+        except (TypeError, ValueError):  # complex, text, an array: one real number each
+            raise ValueError(f"{who}: the value held for {names[i]} must be a real number, "
+                             f"got {value!r}") from None  # fmt: skip
         if not np.isfinite(value):
             raise ValueError(f"{who}: the value held for {names[i]} is not finite: {value}")
         out[i] = value

@@ -124,6 +124,11 @@ class Baumgarte(Law):
                 f"baumgarte: model {model.name!r} has k={k} nonholonomic constraints; "
                 "give the gain k (ḣ = −k h)"
             )
+        if not k and self.k is not None:  # a gain that would act on nothing, silently
+            raise LawError(
+                f"baumgarte: model {model.name!r} has no nonholonomic constraints (k = 0), "
+                f"so the gain k = {self.k:g} has nothing to act on; leave k out"
+            )
         A = np.zeros((m + k, 2 * m + k))
         if m:
             A[:m, :m] = -(self.omega**2) * np.eye(m)

@@ -38,6 +38,11 @@ from .engine.jit import is_njit, python_function
 __all__ = ["Model", "ModelError"]
 
 
+#: the longest parameter or output name: NetCDF names are at most 256 bytes, and a
+#: name becomes variables and attributes with a prefix or suffix of its own
+MAX_NAME = 200
+
+
 class ModelError(ValueError):
     """A model's functions disagree with its declared sizes, or are not usable."""
 
@@ -454,9 +459,17 @@ class Model:
         if names is None or isinstance(names, str) or len(names) == 0:
             raise ModelError(f"Model {self.name!r}: outputs needs output_names, a list of "
                              f"one name per output; got {names!r}")  # fmt: skip
-        names = tuple(str(nm) for nm in names)
+        for nm in names:
+            if not isinstance(nm, str):  # str(None) would make a variable None_final
+                raise ModelError(f"Model {self.name!r}: output_names must be strings, got "
+                                 f"{nm!r} in {list(names)}")  # fmt: skip
+        names = tuple(names)
         taken = reserved_names()
         for nm in names:
+            if len(nm) > MAX_NAME:
+                raise ModelError(f"Model {self.name!r}: output name {nm[:40]!r}… has {len(nm)} "
+                                 f"characters: at most {MAX_NAME} (it names NetCDF "
+                                 "variables)")  # fmt: skip
             if not nm.isidentifier():
                 raise ModelError(f"Model {self.name!r}: output name {nm!r} is not an "
                                  "identifier (letters, digits and _)")  # fmt: skip
@@ -510,6 +523,10 @@ class Model:
                     f"Model {self.name!r}: parameter names must be identifiers (letters, "
                     f"digits and _, not starting with a digit), got {key!r}"
                 )
+            if len(key) > MAX_NAME:
+                raise ModelError(f"Model {self.name!r}: parameter name {key[:40]!r}… has "
+                                 f"{len(key)} characters: at most {MAX_NAME} (it names a "
+                                 "NetCDF attribute)")  # fmt: skip
         return {str(k): _finite_float(v, f"parameter {k!r}") for k, v in params.items()}
 
     def _validate_names(self, coordinates) -> tuple[str, ...]:

@@ -477,7 +477,11 @@ def from_tableau(spec: dict, name: str = "custom") -> Scheme:
         c = np.array(spec["c"], dtype=float)
     except (TypeError, ValueError):
         raise SchemeError("a tableau's A, b and c must be arrays of numbers") from None
-    return Scheme(label, A, b, c, int(spec["order"]), {})
+    order = spec["order"]
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
+        raise SchemeError(f"{label}: tableau order must be a positive integer (the order of "
+                          f"accuracy the tableau claims), got {order!r}")  # fmt: skip
+    return Scheme(label, A, b, c, int(order), {})
 
 
 def as_scheme(scheme, **params) -> Scheme:

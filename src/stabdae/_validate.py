@@ -228,6 +228,10 @@ def seed(value, who: str) -> int:
     return int(value)
 
 
+#: the most fixed steps a run takes (a billion steps of the smallest model take hours;
+#: far more only comes from a tau given in error, e.g. 1e-300)
+MAX_STEPS = 10**12
+
 #: the largest seed: the dataset's ``seed`` attribute is an unsigned 64-bit integer
 MAX_SEED = 2**64 - 1
 
@@ -271,6 +275,9 @@ def fixed_time_grid(span_: float, tau: float, save_dt, who: str, *,
     ``save_dt=None`` stores every step, or about ``default_samples`` samples when given
     (the largest spacing that divides the steps)."""
     nsteps = whole_multiple(span_, tau, "t_end - t0", "tau", who)
+    if nsteps > MAX_STEPS:
+        raise ValueError(f"{who}: t_end - t0 = {span_:g} in steps of tau = {tau:g} is "
+                         f"{nsteps:.3g} steps: at most {MAX_STEPS:.0e} (a larger tau)")  # fmt: skip
     if save_dt is None:
         if default_samples is None:
             return nsteps, 1

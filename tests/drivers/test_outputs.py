@@ -76,3 +76,15 @@ def test_outputs_are_refused_by_name():
         load_scene("pendulum").replace(output_names=["theta"])
     with pytest.raises(stabdae.ModelError, match=r"declares no outputs"):
         load_scene("pendulum").derived(np.zeros(4))
+
+
+def test_output_and_parameter_names_the_dataset_cannot_hold_are_refused():
+    """``output_names = ["theta", None]`` made a variable ``None_final``; a 300-character
+    output or parameter name was accepted and failed at the NetCDF write."""
+    with pytest.raises(stabdae.ModelError, match=r"output_names must be strings, got None"):
+        pendulum_with_outputs(output_names=["theta", None])
+    with pytest.raises(stabdae.ModelError, match=r"output name .* has 300 characters: at most"):
+        pendulum_with_outputs(output_names=["theta", "s" * 300])
+    with pytest.raises(stabdae.ModelError, match=r"parameter name .* has 300 characters"):
+        load_scene("pendulum").replace(params={"g" * 300: 9.81})
+    assert pendulum_with_outputs(output_names=["theta", "s" * 200]).output_names[1] == "s" * 200

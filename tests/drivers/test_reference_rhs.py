@@ -12,7 +12,7 @@ from conftest import SCENES, load_scene, perturbed_state, rhs_function
 from reference.rhs import stabilized_rhs
 
 LAWS = {
-    "baumgarte": lambda model: stabdae.baumgarte(10.0, 0.7, k=3.0),
+    "baumgarte": lambda model: stabdae.baumgarte(10.0, 0.7, k=3.0 if model.k else None),
     "none": lambda model: stabdae.none(),
     # a full constant A: every block coupled (the general sums, not Baumgarte's diagonal)
     "matrix": lambda model: stabdae.matrix(

@@ -22,7 +22,7 @@ TAU, T_END, SAVE = 5e-4, 2.0, 0.05
 def coupled_matrix(model: stabdae.Model, seed: int = 3) -> np.ndarray:
     """A constant A (r × (m+r)) with every block coupled, and Ã stable."""
     rng = np.random.default_rng(seed)
-    base = stabdae.baumgarte(omega=6.0, xi=0.8, k=4.0).A(model)
+    base = stabdae.baumgarte(omega=6.0, xi=0.8, k=4.0 if model.k else None).A(model)
     A = base + 0.5 * rng.standard_normal(base.shape)
     A_tilde = stabdae.matrix(A).A_tilde(model)
     assert np.linalg.eigvals(A_tilde).real.max() < 0

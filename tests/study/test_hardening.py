@@ -262,3 +262,77 @@ def test_a_seed_the_dataset_cannot_store_is_refused_before_any_point(tmp_path):
     model = stabdae.load_model("pendulum")
     with pytest.raises(ValueError, match=r"sample_perturbations: seed must be at most"):
         stabdae.sample_perturbations(model, 4, seed=2**64)
+
+
+@pytest.mark.parametrize("text, match", [
+    (None, r"not a text file in UTF-8 \(byte \d+ is b'\\xff'\)"),
+    ("[search]\nq = " + "[" * 500 + "1" + "]" * 500 + "\n", r"not valid TOML: nested too deeply"),
+    ('[output]\npath = "a\\u0000b.nc"\n', r"\[output\] path: must be a file path without NUL"),
+])
+def test_study_files_that_cannot_be_read_name_the_file_and_key(tmp_path, text, match):
+    """A non-UTF-8 study file's error named no file; a value 500 arrays deep ended in a
+    RecursionError traceback; an output path with a NUL byte failed in the OS."""
+    path = study_file(tmp_path)
+    if text is None:
+        path.write_bytes(path.read_bytes().replace(b"pendulum", b"pend\xffulum"))
+    else:
+        path.write_text(path.read_text() + text)
+    with pytest.raises(StudyError, match=match):
+        load_study(path)
+    assert str(path.name) in str(pytest.raises(StudyError, load_study, path).value)
+
+
+def test_command_line_values_out_of_range_name_their_option(tmp_path, capsys):
+    """``run --threads -2`` failed only after the compile started; ``check --rtol -1`` ran;
+    ``-o`` with a NUL byte named no option."""
+    path = study_file(tmp_path)
+    with pytest.raises(SystemExit) as stop:
+        main(["run", str(path), "--threads", "-2"])
+    assert stop.value.code == 2
+    assert "argument --threads: expected a positive integer, got -2" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["check", "pendulum", "--rtol", "-1"])
+    assert "argument --rtol: expected a positive finite number" in capsys.readouterr().err
+    assert main(["run", str(path), "-o", "a\0b.nc"]) == 2
+    assert "the output path (-o) contains a NUL character" in capsys.readouterr().err
+
+
+def test_a_model_name_is_no_path_in_the_default_output():
+    """``stabdae integrate`` wrote to ``results/<model name>_trajectory.nc`` with the name
+    raw: ``../../escaped\\nline`` wrote outside results/."""
+    from stabdae.study.cli import _safe_stem
+
+    for name in ("../../escaped\nline", "/etc/passwd", "..", "a/b\\c", "pendulum"):
+        out = Path("results") / f"{_safe_stem(name)}_trajectory.nc"
+        assert out.parent == Path("results") and "/" not in _safe_stem(name)
+        assert "\n" not in str(out) and not _safe_stem(name).startswith(".")
+    assert _safe_stem("pendulum") == "pendulum"
+
+
+def test_a_full_disk_during_a_chunk_write_says_so_and_leaves_no_orphan(tmp_path, monkeypatch):
+    """A full disk gave a bare ``[Errno 28]`` and left ``.chunk-*.tmp`` behind."""
+    import errno
+
+    from stabdae.study.store import Manifest, Store
+
+    parts = tmp_path / "p.parts"
+    parts.mkdir()
+    store = Store(Manifest(parts, "key", "study"))
+    store.manifest.save()
+    real = Path.write_bytes
+
+    def full(self, data):
+        if self.name.startswith(".chunk-"):
+            real(self, data[:10])  # part of it, as a full disk leaves it
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, data)
+
+    monkeypatch.setattr(Path, "write_bytes", full)
+    from stabdae._ensemble_dataset import Table
+    import numpy as np
+
+    store.add(0, Table({"x": (("member",), np.zeros(3), {})}, {}, {}))
+    with pytest.raises(OSError, match=r"could not write grid points 0 \(they are computed "
+                                      r"again .*\) to .*chunk-0\.npz \(No space left"):
+        store.flush()
+    assert sorted(p.name for p in parts.iterdir()) == ["study.json"]

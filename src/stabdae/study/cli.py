@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import sys
 import time
 from pathlib import Path
@@ -34,6 +35,23 @@ def _positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
     return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a positive finite number, got {value}")
+    return value
+
+
+def _safe_stem(name: str) -> str:
+    """A model's name as a file name: letters, digits, ``_``, ``-`` and ``.``, no leading
+    dot (a name is the model author's text, not a path: ``../../x`` stays in results/)."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".")
+    return stem or "model"
 
 
 def _cmd_check(args) -> int:
@@ -112,7 +130,7 @@ def _cmd_integrate(args) -> int:
         change = abs(e[-1] - e[0])
         print(f"\nenergy change |E(t_end) - E(0)| = {change:.3e} "
               "(includes the offset's relaxation)")  # fmt: skip
-    out = Path(args.output or f"results/{model.name}_trajectory.nc")
+    out = Path(args.output or f"results/{_safe_stem(model.name)}_trajectory.nc")
     write_netcdf(ds, out)
     print(f"dataset written to {out}")
     return 0 if ds.attrs["status"] == 0 else 1
@@ -271,7 +289,7 @@ def main(argv: list[str] | None = None) -> int:
     chk.add_argument("--velocity", type=float, default=None,
                      help="scale of the random states' velocities, per second (default: the "
                      "reference state's largest speed, or its largest coordinate at rest)")
-    chk.add_argument("--rtol", type=float, default=1e-6,
+    chk.add_argument("--rtol", type=_positive_float, default=1e-6,
                      help="relative tolerance of the finite-difference comparison")
     chk.set_defaults(func=_cmd_check)
 
@@ -330,7 +348,8 @@ def main(argv: list[str] | None = None) -> int:
     grp.add_argument("--workers", type=_positive_int, metavar="N",
                      help="start a local dask cluster of N worker processes")
     grp.add_argument("--scheduler", help="address of a running dask scheduler")
-    run.add_argument("--threads", type=int, help="threads per ensemble (default: all cores)")
+    run.add_argument("--threads", type=_positive_int,
+                     help="threads per ensemble (default: all cores)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.add_argument("--no-plots", action="store_true", help="do not write pictures")
     run.set_defaults(func=_cmd_run)

@@ -137,6 +137,9 @@ def output_path(study: Study, output=None) -> Path:
     """Where the study's dataset goes: ``output`` (a file, or a folder — an existing one or
     one written with a trailing slash — which gets ``<study>.nc``), else the study's
     ``[output] path``, else ``results/<study>.nc``."""
+    if output is not None and "\0" in str(output):
+        raise StudyError(f"stabdae run: the output path (-o) contains a NUL character: "
+                         f"{str(output)!r}")  # fmt: skip
     if output is None:
         if study.output_refused:
             raise StudyError(study.output_refused)

@@ -386,6 +386,8 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
                          f"divides t_end): {', '.join(moved)}")  # fmt: skip
 
     output = raw.get("output", {}).get("path")
+    if output is not None and ("\0" in output or not output.strip()):
+        fail("[output] path", f"must be a file path without NUL characters, got {output!r}")
     refused = None
     if output is not None:  # a study file is data: it writes beneath its folder or here
         target = Path(os.path.normpath(path.parent.resolve() / output))

@@ -123,8 +123,8 @@ class Manifest:
         text = json.dumps({"fingerprint": self.fingerprint, "study": self.study,
                            "chunks": self.chunks}, sort_keys=True)  # fmt: skip
         tmp = self.parts / f".{self.NAME}.tmp"
-        tmp.write_text(text)
-        os.replace(tmp, self.parts / self.NAME)  # a kill leaves the old or the new one
+        # a kill leaves the old or the new one
+        _write_whole(tmp, self.parts / self.NAME, text.encode(), "the run's manifest")
 
 
 #: what a run writes in ``OUTPUT.parts`` (and :func:`clear` removes; ``point-*.nc``: the
@@ -222,12 +222,26 @@ class Store:
                 self._next += 1
             name = f"chunk-{self._next}.npz"
             tmp = parts / f".{name}.tmp"
-            tmp.write_bytes(data)
-            os.replace(tmp, parts / name)
+            _write_whole(tmp, parts / name, data,
+                         f"grid points {', '.join(map(str, points))} (they are computed again "
+                         "by the same command once there is room; the chunks written before "
+                         "are kept)")  # fmt: skip
             self.manifest.chunks[name] = {"sha256": _sha256(data), "points": points}
             self.manifest.save()
             self._next += 1
             self._pending.clear()
+
+
+def _write_whole(tmp: Path, target: Path, data: bytes, what: str) -> None:
+    """``data`` to ``target`` through ``tmp`` (renamed into place); a write that fails (a
+    full disk) leaves no temporary file and says what was not written, and where."""
+    try:
+        tmp.write_bytes(data)
+        os.replace(tmp, target)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        reason = exc.strerror or str(exc)
+        raise OSError(f"could not write {what} to {target} ({reason})") from None
 
 
 def _chunk_number(name: str) -> int:
