@@ -797,3 +797,270 @@ def cli_plot_an_ensemble_dataset(ctx):
     path = write_netcdf(ds, ctx.tmp / "ens.nc")
     code, out, err = ctx.cli("plot", path)
     assert code == 0, err[-2000:]
+
+
+# ------------------------------------------------------------ a study file and its parts
+# are data (the cases by item of the third round of hardening; RESULTS.md lists them)
+def _tripwire(ctx, name: str) -> tuple[Path, Path]:
+    """A Python file that leaves a mark when it runs: (its path without .py, the mark)."""
+    folder = ctx.tmp / f"trip_{name}"
+    folder.mkdir(exist_ok=True)
+    mark = folder / "ran"
+    (folder / "evil.py").write_text(f"open({str(mark)!r}, 'w').write('ran')\n")
+    return folder / "evil", mark
+
+
+for _label, _form in [("absolute", "abs"), ("climbing", "rel"), ("stdlib_this", "this")]:
+    def _fn(ctx, form=_form, label=_label):
+        stem, mark = _tripwire(ctx, label)
+        scenes = ctx.stabdae._loading.scene_dir()
+        given = {"abs": str(stem), "rel": os.path.relpath(stem, scenes),
+                 "this": str(Path(os.__file__).parent / "this")}[form]  # fmt: skip
+        path = ctx.study(f"scene_{label}", _replace(PENDULUM_STUDY, 'file = "pendulum"',
+                                                    f"file = {json.dumps(given)}"))  # fmt: skip
+        for command in ("run", "theory"):
+            code, out, err = ctx.cli(command, path, cwd=path.parent)
+            assert not mark.exists(), "the file named as a scene ran"
+            assert "Beautiful is better than ugly" not in out, "the standard library's this ran"
+            assert code == 2 and "[model] file" in err and "Traceback" not in err, err[-1500:]
+        raise CliError(2, err.strip().splitlines()[-1])
+
+    _fn.__name__ = f"r3_1_scene_name_{_label}"
+    case("error", "[model] file")(_fn)
+
+
+def _manifest(ctx, folder: Path, chunks: dict) -> Path:
+    """A parts folder beside the study in ``folder`` with a manifest under the right run
+    key (anyone can compute it) that lists ``chunks``."""
+    from stabdae.study.run import _fingerprint
+    from stabdae.study.spec import load_study
+
+    path = folder / "study.toml"
+    parts = folder / "out.nc.parts"
+    parts.mkdir(exist_ok=True)
+    key = _fingerprint(load_study(path))
+    (parts / "study.json").write_text(json.dumps({
+        "fingerprint": key, "study": str(path.resolve()),
+        "chunks": {name: {"sha256": "0" * 64, "points": points}
+                   for name, points in chunks.items()}}))  # fmt: skip
+    return parts
+
+
+@case("ok", "stabdae run")
+def r3_2_manifest_naming_files_outside_deletes_nothing(ctx):
+    path = ctx.study("manifest_outside", PENDULUM_STUDY)
+    notes = path.parent / "notes.txt"
+    notes.write_text("a week of notes")
+    far = ctx.tmp / "far_file.txt"
+    far.write_text("not ours")
+    _manifest(ctx, path.parent, {"../notes.txt": [0], str(far): [1]})
+    code, out, err = ctx.cli("run", path, "--no-plots", cwd=path.parent)
+    assert code == 0, err[-2000:]
+    assert notes.read_text() == "a week of notes" and far.read_text() == "not ours"
+    assert "is not the name of a chunk a run writes: ignored" in out, out[-2000:]
+
+
+@case("ok", "stabdae run")
+def r3_2_manifest_chunk_that_is_a_fifo_does_not_hang(ctx):
+    path = ctx.study("manifest_fifo", PENDULUM_STUDY)
+    parts = _manifest(ctx, path.parent, {"chunk-0.npz": [0]})
+    os.mkfifo(parts / "chunk-0.npz")
+    code, out, err = ctx.cli("run", path, "--no-plots", cwd=path.parent, timeout=300)
+    assert code == 0, err[-2000:]
+    assert "is a FIFO, not a chunk a run writes" in out, out[-2000:]
+
+
+@case("ok", "stabdae run")
+def r3_3_study_edited_during_a_dask_run_is_not_mixed(ctx):
+    """``seed`` edited after the first point of a --workers run: every point still has
+    the first seed (the workers never read the study file)."""
+    import xarray as xr
+
+    body = _replace(PENDULUM_STUDY, "tau = [1e-3, 2e-3]", "tau = [1e-3, 2e-3, 4e-3, 5e-3]")
+    path = ctx.study("dask_edit", body)
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src), STABDAE_FLUSH_SECONDS="0")
+    proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(path), "--workers", "2",
+                             "--no-plots", "--quiet"], cwd=path.parent, env=environ,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    parts = path.parent / "out.nc.parts"
+    deadline = time.time() + 300
+    while time.time() < deadline and proc.poll() is None and \
+            not list(parts.glob("chunk-*.npz")):  # fmt: skip
+        time.sleep(0.02)
+    path.write_text(_replace(body, "seed = 1", "seed = 99"))
+    out, err = proc.communicate(timeout=600)
+    assert proc.returncode == 0, err[-2000:]
+    with xr.open_dataset(path.parent / "out.nc") as ds:
+        assert int(ds.attrs["seed"]) == 1, ds.attrs.get("seed")
+
+
+@case("error", "consistent_state")
+def r3_4_consistent_state_tol_nan(ctx):
+    ctx.pendulum().consistent_state({"x": 0.3, "x_dot": 1.0}, tol=float("nan"))
+
+
+@case("error", "consistent_state")
+def r3_4_consistent_state_held_by_name_and_index(ctx):
+    ctx.pendulum().consistent_state({"x": 0.3, 0: 0.4, "x_dot": 1.0})
+
+
+@case("warn", "consistent_state")
+def r3_4_consistent_state_at_a_singular_configuration(ctx):
+    ctx.pendulum().consistent_state({"x": 1.0, "x_dot": 1.0})
+
+
+_study_case("r3_5_seed_too_large", _replace(PENDULUM_STUDY, "seed = 1", f"seed = {2**64}"),
+            who="[ensemble] seed")
+
+
+@case("error", "stabdae run")
+def r3_6_parts_folder_is_a_link(ctx):
+    path = ctx.study("parts_link", PENDULUM_STUDY)
+    target = ctx.tmp / "parts_link_target"
+    target.mkdir(exist_ok=True)
+    (path.parent / "out.nc.parts").symlink_to(target)
+    code, out, err = ctx.cli("run", path, cwd=path.parent)
+    assert not (path.parent / "out.nc").exists(), "computed before refusing"
+    return _cli_outcome(code, out, err, "stabdae run", None, ctx, path)
+
+
+@case("warn", "cache")
+def r3_7_damaged_numba_cache_entry_of_the_library(ctx):
+    cache = ctx.tmp / "numba_cache"
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src), NUMBA_CACHE_DIR=str(cache),
+                   STABDAE_CACHE_DIR="off")  # fmt: skip
+    script = ("import warnings, numpy as np\nwarnings.simplefilter('always')\n"
+              "from stabdae import theory\n"
+              "print(theory.power_norms(np.array([[0.5, 1.0], [0.0, 0.25]])))")
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", script], env=environ, capture_output=True,
+                             text=True, timeout=600)  # fmt: skip
+        assert out.returncode == 0, out.stderr[-2000:]
+        return out
+
+    first = run().stdout
+    entries = sorted(cache.rglob("theory.*.nbc"))
+    assert entries
+    for entry in entries:
+        entry.write_bytes(b"stabdae kernel cache entry 2\n" + b"damaged")
+    again = run()
+    assert again.stdout == first
+    said = [ln for ln in again.stderr.splitlines() if "stabdae:" in ln and "cache" in ln]
+    assert said, again.stderr[-2000:]
+    warnings.warn("cache: " + said[0][said[0].index("stabdae:"):], stacklevel=1)
+
+
+@case("ok", "cache")
+def r3_7_crafted_kernel_cache_index_runs_nothing(ctx):
+    cache = ctx.tmp / "crafted_cache"
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src), STABDAE_CACHE_DIR=str(cache))
+    script = ("import stabdae\nm = stabdae.load_model('pendulum')\n"
+              "print(stabdae.integrate(m, None, stabdae.baumgarte(10.0), 'rk4', 1e-3, 0.05)"
+              ".x.values[-1].tolist())")  # fmt: skip
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", script], env=environ, capture_output=True,
+                             text=True, timeout=600)  # fmt: skip
+        assert out.returncode == 0, out.stderr[-2000:]
+        return out.stdout
+
+    first = run()
+    mark = ctx.tmp / "crafted_ran"
+    import pickle
+
+    crafted = pickle.dumps(_Touch(str(mark)))
+    indexes = sorted((cache / "kernels").glob("*.nbi"))
+    assert indexes
+    for index in indexes:
+        index.write_bytes(crafted)
+    assert run() == first
+    assert not mark.exists(), "a crafted cache index ran code"
+
+
+class _Touch:
+    def __init__(self, path):
+        self.path = path
+
+    def __reduce__(self):
+        return (os.system, (f"touch {self.path}",))
+
+
+@case("error", "stabdae")
+def r3_8_heap_corruption_away_from_the_reference_state(ctx):
+    """A model writing just past ``out`` on the heap when q[0] > 0.5: the process dies
+    (of glibc's abort or a fault) and says why and what to run."""
+    path = ctx.model_file("heapwriter", _model_text(replace={
+        "    out[1] = 9.81\n": "    out[1] = 9.81\n    if q[0] > 0.5:\n"
+                              "        for j in range(2, 40):\n            out[j] = 1e300\n"}))
+    script = ("import stabdae, sys, numpy as np\nm = stabdae.load_model(sys.argv[1])\n"
+              "x0 = np.array([0.0, -1.0, 3.0, 0.0])\n"
+              "stabdae.integrate(m, x0, stabdae.baumgarte(10.0), 'rk4', 1e-3, 1.0)\n")
+    environ = dict(os.environ, PYTHONPATH=str(ctx.src))
+    out = subprocess.run([sys.executable, "-c", script, str(path)], env=environ,
+                         capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert out.returncode != 0, "the defective model ran to the end"
+    said = [ln for ln in out.stderr.splitlines() if ln.startswith("stabdae:")]
+    assert said and "NUMBA_BOUNDSCHECK=1" in out.stderr, out.stderr[-2000:]
+    raise CliError(2, said[0][:300])
+
+
+_study_case("r3_9_tableau_order_text", _replace(
+    PENDULUM_STUDY, '[scheme]\nname = "rk2"',
+    '[scheme]\nname = "mine"\nA = [[0.0, 0.0], [0.5, 0.0]]\nb = [0.0, 1.0]\nc = [0.0, 0.5]\n'
+    'order = "two"'), who="[scheme] order")
+_study_case("r3_9_output_path_nul", _replace(PENDULUM_STUDY, 'path = "out.nc"',
+                                             'path = "a\\u0000b.nc"'), who="[output] path")
+_study_case("r3_9_nested_500_deep", PENDULUM_STUDY + "[search]\nq = " + "[" * 500 + "1"
+            + "]" * 500 + "\n", who="study.toml")
+
+
+@case("error", "study.toml")
+def r3_9_study_file_not_utf8(ctx):
+    path = ctx.study("notutf8", PENDULUM_STUDY)
+    path.write_bytes(path.read_bytes().replace(b"pendulum", b"pend\xffulum"))
+    code, out, err = ctx.cli("run", path, cwd=path.parent)
+    return _cli_outcome(code, out, err, "study.toml", None, ctx, path)
+
+
+@case("ok", "stabdae integrate")
+def r3_9_model_name_with_a_path_stays_in_results(ctx):
+    path = ctx.model_file("escaped", _model_text(replace={
+        'Model("probe_pendulum"': 'Model("../../escaped\\nline"'}))
+    folder = ctx.tmp / "integrate_here"
+    folder.mkdir(exist_ok=True)
+    code, out, err = ctx.cli("integrate", path, "--t-end", "0.05", cwd=folder)
+    assert code == 0, err[-2000:]
+    written = [p for p in folder.rglob("*.nc")]
+    assert written and all(p.parent == folder / "results" for p in written), written
+    assert not [p for p in ctx.tmp.rglob("*line_trajectory.nc")
+                if p.parent != folder / "results"]  # fmt: skip
+
+
+for _label, _fn in [
+    ("integrate_tau_1e-300", lambda ctx: ctx.stabdae.integrate(
+        ctx.pendulum(), None, ctx.law(), "rk2", 1e-300, 1.0)),
+    ("baumgarte_k_without_h", lambda ctx: ctx.stabdae.integrate(
+        ctx.pendulum(), None, ctx.stabdae.baumgarte(10.0, k=5.0), "rk2", 1e-2, 0.1)),
+    ("tableau_order_2.9", lambda ctx: ctx.stabdae._schemes.from_tableau(
+        {"A": [[0, 0], [1, 0]], "b": [0.5, 0.5], "c": [0, 1], "order": 2.9}, name="mine")),
+    ("param_name_300_characters", lambda ctx: ctx.pendulum().replace(params={"g" * 300: 1.0})),
+    ("check_rtol_negative", lambda ctx: ctx.pendulum().check(rtol=-1.0)),
+    ("consistent_state_complex", lambda ctx: ctx.pendulum().consistent_state(
+        {"x": 0.3 + 1j, "x_dot": 1.0})),
+]:
+    _fn.__name__ = f"r3_9_{_label}"
+    case("error", {"integrate_tau_1e-300": "integrate", "baumgarte_k_without_h": "baumgarte",
+                   "tableau_order_2.9": "mine", "param_name_300_characters": "pendulum",
+                   "check_rtol_negative": "check",
+                   "consistent_state_complex": "consistent_state"}[_label])(_fn)
+
+
+@case("error", "stabdae run")
+def r3_9_run_threads_negative(ctx):
+    path = ctx.study("threads", PENDULUM_STUDY)
+    start = time.perf_counter()
+    code, out, err = ctx.cli("run", path, "--threads", "-2", cwd=path.parent)
+    assert time.perf_counter() - start < 20, "refused only after compiling"
+    assert "--threads" in err, err[-1500:]
+    return _cli_outcome(code, out, err, "stabdae run", None, ctx, path)
