@@ -29,6 +29,7 @@ every random state (at a reference at rest it is zero whatever its sign).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -166,11 +167,9 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
         ``report.ok`` is True when every piece agrees; ``str(report)`` is a table and
         ``report.failures`` names the pieces that disagree.
     """
-    from . import _validate as check
-
     who = f"{model.name}.check"
-    rtol = check.positive(rtol, "rtol", who)
-    radius = check.positive(radius, "radius", who)
+    rtol = _positive(rtol, "rtol", who)
+    radius = _positive(radius, "radius", who)
     if isinstance(states, bool) or not isinstance(states, (int, np.integer)) or states < 0:
         raise ValueError(f"{who}: states must be a non-negative integer, got {states!r}")
     p = model.param_vector(params)
@@ -192,6 +191,18 @@ def check_model(model: Model, params=None, *, states=3, radius=1e-2, seed=0, rto
     for i, (x, t) in enumerate(zip(xs, ts)):
         _check_state(model, report, i, x, t, p)
     return report
+
+
+def _positive(value, name: str, who: str) -> float:
+    # The drivers' rule (stabdae._validate.positive), restated: that module binds laws to
+    # models, and the model module imports this one.
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: {name} must be a real number, got {value!r}") from None
+    if not (math.isfinite(out) and out > 0):
+        raise ValueError(f"{who}: {name} must be positive and finite, got {value!r}")
+    return out
 
 
 def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> None:

@@ -249,6 +249,28 @@ def test_a_worker_result_under_another_run_key_is_refused(tmp_path, monkeypatch)
     assert not (tmp_path / "x.nc").exists()
 
 
+def test_the_run_key_is_the_same_for_a_scene_from_a_wheel_and_from_a_source_tree(tmp_path):
+    """A worker with stabdae from a source tree (the scene loaded as a file's module) and
+    a main process with it installed (``stabdae.scenes.pendulum``) computed different run
+    keys for the same study, and every result was refused: the module name was in the key.
+    The key holds the source by content, not where it was imported from; a changed line
+    still changes it."""
+    import dataclasses
+
+    from stabdae._loading import load_as, scene_dir
+    from stabdae.study.run import _fingerprint
+
+    study = load_study(shared_study(tmp_path, members=16))
+    file = scene_dir() / "pendulum.py"
+    keys = {_fingerprint(dataclasses.replace(study, model=load_as(file, name)))
+            for name in ("stabdae_model_from_source_tree", "stabdae_wheel_scenes_pendulum")}
+    assert len(keys) == 1
+    edited = tmp_path / "pendulum.py"
+    edited.write_text(file.read_text().replace("\n", "\n\n", 1))  # every line moves by one
+    moved = load_as(edited, "stabdae_model_edited_copy")
+    assert _fingerprint(dataclasses.replace(study, model=moved)) not in keys
+
+
 # ------------------------------------------------------------------ values out of range
 def test_a_seed_the_dataset_cannot_store_is_refused_before_any_point(tmp_path):
     """A seed of 2**64 passed validation, then failed after every grid point was computed

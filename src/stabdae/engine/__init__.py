@@ -25,9 +25,12 @@ one floor up do, once).  By role:
   :mod:`.decay.traces`;
 * :mod:`.sampler` — placing initial states at prescribed constraint perturbations;
 * :mod:`.threads` — running ``nogil`` kernels over chunks of members on a thread pool;
-* :mod:`.crash` — what is printed when a compiled kernel crashes (segmentation fault);
+* :mod:`.crash` — what is printed when a compiled kernel crashes (segmentation fault, abort);
 * :mod:`.cache` — the compile spec (:class:`.cache.Spec`), the per-model memo of the
   compiled closures and their on-disk cache;
+* :mod:`.checked_cache` — numba's on-disk cache read as data: a JSON index, and each entry's
+  key and checksum checked before it is unpickled (the kernel cache's and the library's own
+  ``cache=True`` functions');
 * :mod:`.ahead` — a new model's sampler compiled into that cache by a helper process while
   this one compiles the ensemble kernel.
 """

@@ -127,9 +127,18 @@ def _fingerprint(study: Study) -> str:
     # the model's functions as the kernels are keyed: helpers they call wherever those
     # live, and the values of the globals and module attributes they read
     model = study.model
-    for piece, fn in sorted({**model.functions, "energy": model.energy,
-                             "outputs": model.outputs}.items()):  # fmt: skip
-        h.update(f"{piece}={function_fingerprint(fn) if fn is not None else None}".encode())
+    pieces = sorted({**model.functions, "energy": model.energy,
+                     "outputs": model.outputs}.items())  # fmt: skip
+    # The model's own module name is where it was loaded from, not what it computes: a
+    # scene is stabdae.scenes.NAME from a wheel and a file's module from a source tree,
+    # and a dask worker may have either.  Its source is in the key by content.
+    own = {getattr(getattr(fn, "py_func", fn), "__module__", None) for _, fn in pieces}
+    own.discard(None)
+    for piece, fn in pieces:
+        text = function_fingerprint(fn) if fn is not None else None
+        for name in own:
+            text = text and text.replace(name + ".", "<model>.")
+        h.update(f"{piece}={text}".encode())
     return h.hexdigest()
 
 

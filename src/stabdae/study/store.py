@@ -83,6 +83,12 @@ def file_kind(path: Path) -> str:
     return "a regular file" if stat.S_ISREG(mode) else "not a regular file"
 
 
+def _shown(name) -> str:
+    """A manifest entry's name as a message shows it: a crafted one may be megabytes."""
+    text = repr(name)
+    return text if len(text) <= 240 else text[:239] + "…"
+
+
 class Manifest:
     """``OUTPUT.parts/study.json``: the run key, the study file (resolved) and, for every
     chunk written, its SHA-256 and grid points, so that a chunk altered afterwards is
@@ -111,7 +117,7 @@ class Manifest:
             chunks, refused = {}, []
             for k, v in raw.get("chunks", {}).items():
                 if not (isinstance(k, str) and CHUNK_NAME.fullmatch(k)):
-                    refused.append(repr(k)[:80])
+                    refused.append(_shown(k))
                     continue
                 chunks[k] = {"sha256": str(v["sha256"]),
                              "points": [int(i) for i in v["points"]]}  # fmt: skip
