@@ -226,3 +226,63 @@ def test_checked_kernels_compile_the_models_functions_with_numba(monkeypatch):
     assert not isinstance(_rejit(forces, None), Dispatcher)  # the emitter's intrinsic
     monkeypatch.setattr(numba.config, "BOUNDSCHECK", 1)
     assert isinstance(_rejit(forces, None), Dispatcher)
+
+
+def _long_sum(terms: int) -> str:
+    """A function whose one expression is a sum of ``terms`` products, left to right, as
+    ``stabdae generate`` writes an expanded model's: an AST ``terms`` deep."""
+    body = " + ".join(f"{(-1) ** i * (i + 1) / 7:.17g} * x[{i % 3}] * x[{(i + 1) % 3}]"
+                      for i in range(terms))  # fmt: skip
+    return f"def f(x, out):\n    out[0] = {body} - 2.0 * 3.0\n    out[1] = -(-x[0])\n"
+
+
+def test_an_expression_thousands_deep_is_emitted_at_the_default_recursion_limit():
+    """A generated 14-coordinate bicycle (8752 operations, one expression of f_accel 4163
+    long) raised RecursionError from every driver: the constant folding and the typing
+    recursed once per operator.  Now the walks keep their own stacks: 2500 terms (Python's
+    own parser stops near 3000 at the default limit) compile under Python's default
+    recursion limit and give Python's own bits; a refusal inside such an expression says where
+    without printing all of it."""
+    import sys
+
+    assert sys.getrecursionlimit() <= 1000 + 200  # as a user's process has it (pytest's)
+    source = _long_sum(2500)
+    fn_def = ast.parse(source).body[0]
+    intr = emitted(fn_def, {}, "emit_test_deep")
+    ns = {"_emitted": intr}
+    exec("def g(x, out):\n    return _emitted(x, out)\n", ns)
+    plain = {}
+    exec(source, plain)
+    got, want = np.zeros(2), np.zeros(2)
+    x = np.array([0.3, -1.25, 2.0 / 3.0])
+    njit(error_model="numpy")(ns["g"])(x, got)
+    # Python's own float64 evaluation is the reference: the same operations in the same
+    # order, unfused (numba's compilation of this source takes minutes)
+    plain["f"](x, want)
+    assert got.tobytes() == want.tobytes() and got[1] == x[0]
+
+    refused = ast.parse(source.replace("x[2]", "x[2:3]", 1)).body[0]
+    with pytest.raises(NotImplementedError) as info:
+        emitted(refused, {}, "emit_test_deep_refused")
+    assert len(str(info.value)) < 400 and "x[2:3]" in str(info.value)
+
+
+def test_a_model_with_an_expression_thousands_deep_integrates(tmp_path):
+    """The drivers on a model whose force is one expression 2500 operations deep: the
+    pendulum's, with terms that cancel exactly left to right (``t - t + u - u + … + g``
+    is ``g`` in floating point), so its trajectory is the pendulum's bit for bit."""
+    import stabdae
+    from stabdae._loading import scene_dir
+
+    terms = " + ".join(f"{(i % 7 + 1) * 1e-3:.3g} * q[{i % 2}] * v[{(i + 1) % 2}] - "
+                       f"{(i % 7 + 1) * 1e-3:.3g} * q[{i % 2}] * v[{(i + 1) % 2}]"
+                       for i in range(1250))  # fmt: skip
+    source = (scene_dir() / "pendulum.py").read_text()
+    assert source.count("    out[1] = p[0]\n") == 1
+    (tmp_path / "deep.py").write_text(source.replace("    out[1] = p[0]\n",
+                                                     f"    out[1] = {terms} + p[0]\n"))
+    deep, plain = stabdae.load_model(tmp_path / "deep.py"), stabdae.load_model("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    runs = [stabdae.integrate(m, law=law, scheme="midpoint", tau=1e-3, t_end=0.2)
+            for m in (deep, plain)]  # fmt: skip
+    assert runs[0]["x"].values.tobytes() == runs[1]["x"].values.tobytes()

@@ -108,6 +108,27 @@ def _operation(node):
     return None
 
 
+def _operands(node) -> list:
+    """The operand nodes of an operator's or a call's node, left to right."""
+    operation = _operation(node)
+    return list(operation[1]) if operation is not None else list(node.args)
+
+
+#: what :meth:`_Walk.leaf` returns for a node whose value needs its operands'
+_NOT_LEAF = object()
+
+
+def _text(node, limit: int = 200) -> str:
+    """``node`` as source for a message, cut to ``limit`` characters (a generated
+    expression thousands deep is more than a message, and than ``ast.unparse``'s
+    recursion, can hold)."""
+    try:
+        text = ast.unparse(node)
+    except RecursionError:
+        return f"a {type(node).__name__} nested too deep to print"
+    return text if len(text) <= limit else text[:limit] + " …"
+
+
 def _index(node) -> list:
     """A subscript's indices."""
     return node.elts if isinstance(node, ast.Tuple) else [node]
@@ -118,36 +139,62 @@ def _constant_type(typingctx, value):
     return types.maybe_literal(value) or typingctx.resolve_value_type(value)
 
 
+def _postorder(root):
+    """Every node under ``root`` (itself last), children before their parent, left to
+    right: the order a recursive walk would visit them, with a stack of its own (a
+    generated expression may nest thousands deep, past Python's recursion limit)."""
+    out, stack = [], [(root, False)]
+    while stack:
+        node, expanded = stack.pop()
+        if expanded:
+            out.append(node)
+            continue
+        stack.append((node, True))
+        stack.extend((child, False) for child in reversed(list(ast.iter_child_nodes(node))))
+    return out
+
+
+def _folded(node):
+    """``node`` itself, or the constant it folds to (its operands already folded)."""
+    if isinstance(node, ast.UnaryOp):
+        if (isinstance(node.op, (ast.USub, ast.UAdd)) and isinstance(node.operand, ast.Constant)
+                and type(node.operand.value) in (int, float)):  # fmt: skip
+            value = node.operand.value
+            return ast.copy_location(ast.Constant(-value if isinstance(node.op, ast.USub)
+                                                  else +value), node)  # fmt: skip
+        return node
+    if not isinstance(node, ast.BinOp):
+        return node
+    a, b = node.left, node.right
+    if not (type(node.op) in _BINARY and isinstance(a, ast.Constant)
+            and isinstance(b, ast.Constant) and type(a.value) in (int, float)
+            and type(b.value) in (int, float)):  # fmt: skip
+        return node
+    try:
+        value = _BINARY[type(node.op)](a.value, b.value)
+    except (ArithmeticError, TypeError, ValueError):
+        return node  # (CPython leaves it to run time too)
+    if type(value) not in (int, float) or (type(value) is int and abs(value) >= 2**63):
+        return node
+    return ast.copy_location(ast.Constant(value), node)
+
+
 def _fold(node):
     """Number constants folded as CPython folds them before numba sees the bytecode
-    (``-2.0``, ``2 * 3``): the same constants, typed as numba types them."""
-
-    class Fold(ast.NodeTransformer):
-        def visit_UnaryOp(self, node):
-            node = self.generic_visit(node)
-            if (isinstance(node.op, (ast.USub, ast.UAdd)) and isinstance(node.operand, ast.Constant)
-                    and type(node.operand.value) in (int, float)):  # fmt: skip
-                value = node.operand.value
-                return ast.copy_location(ast.Constant(-value if isinstance(node.op, ast.USub)
-                                                      else +value), node)  # fmt: skip
-            return node
-
-        def visit_BinOp(self, node):
-            node = self.generic_visit(node)
-            a, b = node.left, node.right
-            if not (type(node.op) in _BINARY and isinstance(a, ast.Constant)
-                    and isinstance(b, ast.Constant) and type(a.value) in (int, float)
-                    and type(b.value) in (int, float)):  # fmt: skip
-                return node
-            try:
-                value = _BINARY[type(node.op)](a.value, b.value)
-            except (ArithmeticError, TypeError, ValueError):
-                return node  # (CPython leaves it to run time too)
-            if type(value) not in (int, float) or (type(value) is int and abs(value) >= 2**63):
-                return node
-            return ast.copy_location(ast.Constant(value), node)
-
-    return Fold().visit(node)  # (never compiled by Python: no locations needed)
+    (``-2.0``, ``2 * 3``): the same constants, typed as numba types them.  Bottom-up over
+    :func:`_postorder`, each node's fields pointed at its folded children."""
+    replaced: dict = {}
+    for each in _postorder(node):
+        for field, value in ast.iter_fields(each):
+            if isinstance(value, ast.AST) and id(value) in replaced:
+                setattr(each, field, replaced[id(value)])
+            elif isinstance(value, list):
+                value[:] = [replaced.get(id(v), v) if isinstance(v, ast.AST) else v
+                            for v in value]  # fmt: skip
+        new = _folded(each)
+        if new is not each:
+            replaced[id(each)] = new
+    return replaced.get(id(node), node)  # (never compiled by Python: no locations needed)
 
 
 class _Function:
@@ -178,7 +225,7 @@ class _Function:
             self._check_expr(self.ret.value, defined)
 
     def refuse(self, node):
-        raise _Refused(f"{ast.unparse(node)} in {self.fn_def.name}")
+        raise _Refused(f"{_text(node)} in {self.fn_def.name}")
 
     def global_(self, name):
         if name in self.namespace:
@@ -221,27 +268,35 @@ class _Function:
                 return value
         return None
 
-    def _check_expr(self, node, defined):
+    def _check_expr(self, root, defined):
+        """Refuse an expression outside the language (its nodes in a walk of its own: no
+        recursion on its depth)."""
+        todo = [root]
+        while todo:
+            node = todo.pop()
+            todo.extend(reversed(self._checked_operands(node, defined)))
+
+    def _checked_operands(self, node, defined) -> list:
+        """Check ``node`` itself; the operands still to check."""
         if isinstance(node, ast.Name) and node.id in defined:
-            return
+            return []
         if isinstance(node, ast.Name) and node.id in self.assigned:
             self.refuse(node)  # read before it is assigned
         if self.constant(node) is not None:
-            return
+            return []
         if isinstance(node, ast.Subscript):
             self._entry(node, defined, store=False)
-        elif isinstance(node, ast.BinOp):
+            return []
+        if isinstance(node, ast.BinOp):
             if isinstance(node.op, ast.Pow) and not (isinstance(node.right, ast.Constant)
                                                      and type(node.right.value) in (int, float)):
                 self.refuse(node)  # (numba may lower ``x ** c`` by c's value one day)
-            self._check_expr(node.left, defined)
-            self._check_expr(node.right, defined)
-        elif isinstance(node, ast.UnaryOp):
-            self._check_expr(node.operand, defined)
-        elif isinstance(node, ast.Compare) and len(node.ops) == 1:
-            self._check_expr(node.left, defined)
-            self._check_expr(node.comparators[0], defined)
-        elif isinstance(node, ast.Call) and not node.keywords:
+            return [node.left, node.right]
+        if isinstance(node, ast.UnaryOp):
+            return [node.operand]
+        if isinstance(node, ast.Compare) and len(node.ops) == 1:
+            return [node.left, node.comparators[0]]
+        if isinstance(node, ast.Call) and not node.keywords:
             fn = self.callee(node)
             if (_SPECIAL.get(fn, len(node.args)) != len(node.args)
                     or (fn in (max, min) and len(node.args) != 2)):  # fmt: skip
@@ -251,11 +306,9 @@ class _Function:
             if fn in ("_at1", "_at2"):
                 self._array(node.args[0], defined)
                 self._indices(node, node.args[1:], int(fn[-1]))
-            else:
-                for arg in node.args:
-                    self._check_expr(arg, defined)
-        else:
-            self.refuse(node)
+                return []
+            return list(node.args)
+        self.refuse(node)
 
     def _array(self, node, defined):
         if not (isinstance(node, ast.Name) and node.id in self.params):
@@ -343,13 +396,31 @@ class _Walk:
         else:
             self.names[target.id] = self.expr(value)
 
-    def operation(self, node):
-        """The value of an operator's node (None: not an operator)."""
+    def expr(self, root):
+        """The value of an expression, bottom-up: its operands left to right, then the
+        operation, as a recursive walk would, with a stack of its own (a generated
+        expression may nest thousands deep, past Python's recursion limit)."""
+        values: dict = {}
+        stack = [(root, False)]
+        while stack:
+            node, ready = stack.pop()
+            if ready:
+                values[id(node)] = self.combine(node, [values[id(a)] for a in _operands(node)])
+                continue
+            value = self.leaf(node)
+            if value is not _NOT_LEAF:
+                values[id(node)] = value
+                continue
+            stack.append((node, True))
+            stack.extend((a, False) for a in reversed(_operands(node)))
+        return values[id(root)]
+
+    def combine(self, node, values):
+        """The value of an operator's or a call's node from its operands' ``values``."""
         operation = _operation(node)
-        if operation is None:
-            return None
-        op, operands = operation
-        return self.apply(node, op, [self.expr(a) for a in operands])
+        if operation is not None:
+            return self.apply(node, operation[0], values)
+        return self.call(node, values)
 
 
 class _Typing(_Walk):
@@ -374,7 +445,7 @@ class _Typing(_Walk):
         self.sigs[id(node)] = sig
         return sig.return_type
 
-    def expr(self, node):
+    def leaf(self, node):
         fn = self.fn
         if isinstance(node, ast.Name) and node.id in self.names:
             return self.names[node.id]
@@ -383,22 +454,23 @@ class _Typing(_Walk):
             return _constant_type(self.tc, value)
         if isinstance(node, ast.Subscript):
             return self.entry(node.value.id, node.slice)
-        value = self.operation(node)
-        if value is not None:
-            return value
+        if _operation(node) is not None:
+            return _NOT_LEAF
         if isinstance(node, ast.Call):
-            callee = fn.callee(node)
-            if callee in ("_at1", "_at2"):
+            if fn.callee(node) in ("_at1", "_at2"):
                 return self.names[node.args[0].id].dtype
-            args = [self.expr(a) for a in node.args]
-            if callee in ("fma", "fnma"):
-                return types.float64
-            if callee in (max, min):  # numba's max of two floats, written out (below)
-                if not all(isinstance(a, types.Float) for a in args):
-                    raise _Refused(f"{ast.unparse(node)} of {args}")
-                return types.float64
-            return self.op(node, callee, args)
-        raise _Refused(ast.unparse(node))
+            return _NOT_LEAF
+        raise _Refused(_text(node))
+
+    def call(self, node, args):
+        callee = self.fn.callee(node)
+        if callee in ("fma", "fnma"):
+            return types.float64
+        if callee in (max, min):  # numba's max of two floats, written out (below)
+            if not all(isinstance(a, types.Float) for a in args):
+                raise _Refused(f"{_text(node)} of {args}")
+            return types.float64
+        return self.op(node, callee, args)
 
     def apply(self, node, fn, values):
         return self.op(node, fn, values)
@@ -460,7 +532,7 @@ class _Lowering(_Walk):
         t = _constant_type(self.context.typing_context, value)
         return t, self.context.get_constant(types.unliteral(t), value)
 
-    def expr(self, node):
+    def leaf(self, node):
         fn, b = self.fn, self.builder
         if isinstance(node, ast.Name) and node.id in self.names:
             return self.names[node.id]
@@ -471,14 +543,16 @@ class _Lowering(_Walk):
             index = _index(node.slice)
             aryty, ptr = self.pointer(node.value, [i.value for i in index])
             return aryty.dtype, b.load(ptr)
-        value = self.operation(node)
-        if value is not None:
-            return value
-        callee = fn.callee(node)
-        if callee in ("_at1", "_at2"):
+        if _operation(node) is not None:
+            return _NOT_LEAF
+        if fn.callee(node) in ("_at1", "_at2"):
             aryty, ptr = self.pointer(node.args[0], [i.value for i in node.args[1:]])
             return aryty.dtype, b.load(ptr)
-        args = [self.expr(a) for a in node.args]
+        return _NOT_LEAF
+
+    def call(self, node, args):
+        fn, b = self.fn, self.builder
+        callee = fn.callee(node)
         if callee in ("fma", "fnma"):
             x, y, z = (self.cast(a, types.float64) for a in args)
             x = b.fneg(x) if callee == "fnma" else x
