@@ -555,6 +555,14 @@ class _LocalNames:
         self.taken = taken
         self.printer = _Printer(self.rename)
 
+    def fresh(self, base: str) -> str:
+        """A local name of none of the symbols (``base``, else ``base_``, …)."""
+        name = base
+        while name in self.taken or name in _RESERVED:
+            name += "_"
+        self.taken.add(name)
+        return name
+
     def cse_symbols(self):
         prefix = "e"
         while any(n.startswith(prefix) and n[len(prefix):].isdigit() for n in self.taken):
@@ -618,17 +626,23 @@ def _function(piece: str, expr, names: _LocalNames) -> tuple[str, int]:
     body = names.unpack(used)
     for sym, value in replacements:
         names.rename[sym] = str(sym)  # the printer reads the same mapping
-        body.append(_assign(str(sym), names.code(value)))
+        body.extend(_assignments(str(sym), names.code(value)))
     reduced_of = dict(zip([tg for tg, _ in nonzero], reduced))
     if piece == "energy":
-        body.append(_assign("return", names.code(reduced[0]), op=""))
+        code = names.code(reduced[0])
+        if len(_split_top(code)) > _TERMS:
+            total = names.fresh("total")
+            body.extend(_assignments(total, code))
+            code = total
+        body.append(_assign("return", code, op=""))
     else:
         zeros = any(e == 0 for e in entries)
         if zeros and len(targets) > 1 and matrix:
             body.append("out[:, :] = 0.0")
             targets = [tg for tg in targets if tg in reduced_of]
         for tg in targets:
-            body.append(_assign(tg, names.code(reduced_of[tg]) if tg in reduced_of else "0.0"))
+            body.extend(_assignments(tg, names.code(reduced_of[tg]) if tg in reduced_of
+                                     else "0.0"))  # fmt: skip
         if piece == "mass":
             n = M.shape[0]
             for i in range(n):
@@ -640,6 +654,25 @@ def _function(piece: str, expr, names: _LocalNames) -> tuple[str, int]:
     ops = sum(sp.count_ops(e) for e in [*reduced, *(r for _, r in replacements)])
     return (f"@njit(cache=True)\ndef {piece}({_signature(piece)}):\n"
             + "\n".join("    " + ln for ln in "\n".join(lines).splitlines()), int(ops))  # fmt: skip
+
+
+#: top-level terms of a sum per statement: an expanded derivation's sums run to thousands
+#: of terms, an expression as deep, past what Python compiles at its default recursion
+#: limit (a loaded model file is compiled by Python first)
+_TERMS = 64
+
+
+def _assignments(target: str, code: str) -> list[str]:
+    """``target = code``, a long sum as partial sums into ``target`` of at most
+    :data:`_TERMS` terms each, in the order written (``t = a + b``, ``t = t - c``): the
+    same operations in the same order, so the same numbers."""
+    parts = _split_top(code)
+    if len(parts) <= _TERMS:
+        return [_assign(target, code)]
+    lines = [_assign(target, "".join(parts[:_TERMS]))]
+    for k in range(_TERMS, len(parts), _TERMS):
+        lines.append(_assign(target, target + "".join(parts[k:k + _TERMS])))
+    return lines
 
 
 def _assign(target: str, code: str, op: str = " =") -> str:

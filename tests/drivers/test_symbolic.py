@@ -401,3 +401,51 @@ def test_a_generated_model_of_8000_operations_runs_every_driver(tmp_path):
     ds = stabdae.ensemble(model, law, "midpoint", tau=1e-3, t_end=1.0, members=16)
     beta = ds["beta"].values
     assert np.all(np.isfinite(beta)) and np.all(np.abs(beta / 10.0 - 1.0) <= 0.02), beta
+
+
+def test_a_sum_of_thousands_of_terms_is_written_as_partial_sums(tmp_path, monkeypatch):
+    """An expanded derivation writes sums of thousands of terms (the bicycle's spec with
+    ``expand=True``: an expression 12,715 levels deep in its energy), and Python itself
+    could not compile the model file ("maximum recursion depth exceeded during
+    compilation").  Now a sum is written as partial sums of at most 64 terms into its
+    target, in the order written, so the functions give the same bits as the sum in one
+    statement, and no statement is deeper than a few dozen levels."""
+    import ast
+
+    import stabdae.symbolic as symbolic
+
+    (x, y), (xd, yd) = coordinates("x y")
+    terms = 150  # one sum of ~150 terms in f, f_q, f_accel and the energy
+    potential = sum(sp.Rational(i, 7) * x ** (i % 5) * y ** (i % 3 + 1) * sp.cos(i * x)
+                    for i in range(1, terms + 1))  # fmt: skip
+    def system():
+        return System("long_sums", q=[x, y], v=[xd, yd],
+                      lagrangian=(xd**2 + yd**2) / 2 - potential,
+                      holonomic=[y - sum(x ** (i % 4) * sp.sin(i * x) / i
+                                         for i in range(1, terms + 1))],
+                      params={}, reference_state=[0.0] * 4, simplify=False)  # fmt: skip
+
+    split = system().write(tmp_path / "split.py")
+    monkeypatch.setattr(symbolic, "_TERMS", 10**9)
+    whole = system().write(tmp_path / "whole.py")
+    depth = {}
+    for path in (split, whole):
+        tree = ast.parse(path.read_text())
+        deepest, stack = 0, [(tree, 0)]
+        while stack:
+            node, d = stack.pop()
+            deepest = max(deepest, d)
+            stack.extend((c, d + 1) for c in ast.iter_child_nodes(node))
+        depth[path.stem] = deepest
+    assert depth["whole"] > 150 and depth["split"] < 100, depth
+    a = stabdae.load_model(split)
+    b = stabdae.load_model(whole)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        xs = rng.uniform(-1.0, 1.0, 4)
+        for piece in ("forces", "f", "f_q", "f_accel", "energy"):
+            # as Python (numba's compilation of the long sums would take minutes; the
+            # emitted code gives Python's bits, test_emit)
+            va = np.asarray(a._value(piece, 0.0, xs, a.default_params(), python=True))
+            vb = np.asarray(b._value(piece, 0.0, xs, b.default_params(), python=True))
+            assert va.tobytes() == vb.tobytes(), piece
