@@ -154,6 +154,27 @@ def test_a_manifest_names_only_chunks_inside_its_folder(tmp_path, no_hang):
     assert (parts / "chunk-7.npz").is_symlink()
 
 
+def test_a_run_says_when_its_parts_folder_stays_for_files_it_did_not_write(tmp_path):
+    """A FIFO under a chunk's name is left alone, its point computed again; the run then
+    removed its own files and said nothing of the folder that stayed behind.  Now it
+    names what it left and why."""
+    from stabdae.study.run import _fingerprint
+
+    path = shared_study(tmp_path, members=16, t_end=0.2, omegas="5.0")
+    parts = tmp_path / "out.nc.parts"
+    parts.mkdir()
+    os.mkfifo(parts / "chunk-0.npz")
+    (parts / "study.json").write_text(json.dumps({
+        "fingerprint": _fingerprint(load_study(path)), "study": str(path.resolve()),
+        "chunks": {"chunk-0.npz": {"sha256": "0" * 64, "points": [0]}}}))  # fmt: skip
+    said = []
+    out = run_study(path, tmp_path / "out.nc", progress=False, log=said.append)
+    text = "\n".join(map(str, said))
+    assert out.exists() and (parts / "chunk-0.npz").exists()
+    assert not (parts / "study.json").exists()
+    assert f"{parts} is left in place: it holds chunk-0.npz, which no run wrote" in text
+
+
 def test_clear_removes_regular_files_of_its_own_names_only(tmp_path):
     from stabdae.study.store import clear
 

@@ -323,7 +323,11 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
         store.flush()
         raise
     clear(parts)
+    left = sorted(p.name for p in parts.iterdir() if p.name != "lock") if parts.is_dir() else []
     log(summary(ds))
+    if left:  # files no run wrote (a FIFO under a chunk's name, a user's): theirs to remove
+        shown = ", ".join(left[:5]) + (f" and {len(left) - 5} more" if len(left) > 5 else "")
+        log(f"{parts} is left in place: it holds {shown}, which no run wrote")
     wall, compiled = time.perf_counter() - start, compile_seconds() - compiling
     timing = ""
     if todo and not (workers or scheduler):  # (on workers, the times are theirs)
