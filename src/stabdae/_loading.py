@@ -51,6 +51,18 @@ def model_file(source) -> Path:
     return path.resolve()
 
 
+def local_sources(path: Path) -> dict[Path, bytes]:
+    """The bytes of :func:`local_imports`, by path, read once: what a run is keyed by and
+    what its dask workers load must be the same bytes, whatever the files become."""
+    out = {}
+    for each in local_imports(path):
+        try:
+            out[each] = each.read_bytes()
+        except OSError:
+            continue
+    return out
+
+
 def local_imports(path: Path) -> list[Path]:
     """The model file and the modules of its own folder that it imports, recursively (what
     its numbers can depend on besides the library)."""

@@ -255,6 +255,36 @@ def test_an_edit_of_the_study_file_during_a_dask_run_changes_nothing(tmp_path, m
     same_data(ds, xr.open_dataset(clean).load())
 
 
+def test_an_edit_while_the_dask_cluster_starts_changes_nothing(tmp_path, monkeypatch):
+    """The model file's bytes for the workers were read when the cluster was up, seconds
+    after the run key: an edit of the model in between made every worker's key differ,
+    and the run stopped with an error (nothing mixed, but the run lost).  The bytes are
+    read once, with the study; the run is the study and model as they were read."""
+    pytest.importorskip("distributed")
+    import xarray as xr
+
+    import stabdae.study.run as runner
+
+    model = tmp_path / "home" / "pend.py"
+    model.parent.mkdir()
+    model.write_text((Path(__file__).resolve().parents[2] / "kernels" / "pendulum.py")
+                     .read_text())  # fmt: skip
+    path = shared_study(tmp_path / "home", members=16, t_end=0.2, omegas="5.0")
+    path.write_text(path.read_text().replace('file = "pendulum"', 'file = "pend.py"'))
+    clean = run_study(path, tmp_path / "clean.nc", progress=False, log=lambda *a: None)
+    real = runner._run_dask
+
+    def edit_then_start(*args, **kwargs):
+        path.write_text(path.read_text().replace("seed = 3", "seed = 99"))
+        model.write_text(model.read_text().replace("9.81", "1.62"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(runner, "_run_dask", edit_then_start)
+    out = run_study(path, tmp_path / "dask.nc", workers=1, progress=False,
+                    log=lambda *a: None)  # fmt: skip
+    same_data(xr.open_dataset(out).load(), xr.open_dataset(clean).load())
+
+
 def test_a_worker_result_under_another_run_key_is_refused(tmp_path, monkeypatch):
     """The run key is checked on every result a worker returns."""
     pytest.importorskip("distributed")

@@ -33,7 +33,7 @@ from .._boundary import boundary
 from .._ensemble import ensemble_table
 from .._ensemble_dataset import Table
 from .._integrate import IntegrationWarning
-from .._loading import local_imports
+from .._loading import local_sources
 from .._schema import append_history, utc_now, write_netcdf
 from .._version import __version__
 from ..engine.cache import function_fingerprint, library_fingerprint
@@ -121,9 +121,8 @@ def _fingerprint(study: Study) -> str:
     h.update(json.dumps(study.ensemble, sort_keys=True).encode())
     h.update(__version__.encode())
     h.update(library_fingerprint().encode())
-    if study.model_file is not None:
-        for path in local_imports(study.model_file):
-            h.update(path.name.encode() + b"\0" + path.read_bytes())
+    for path, data in _sources(study).items():
+        h.update(path.name.encode() + b"\0" + data)
     # the model's functions as the kernels are keyed: helpers they call wherever those
     # live, and the values of the globals and module attributes they read
     model = study.model
@@ -140,6 +139,14 @@ def _fingerprint(study: Study) -> str:
             text = text and text.replace(name + ".", "<model>.")
         h.update(f"{piece}={text}".encode())
     return h.hexdigest()
+
+
+def _sources(study: Study) -> dict:
+    """The model's source files' bytes as the study read them (read now for a study made
+    without :func:`load_study`)."""
+    if study.model_sources or study.model_file is None:
+        return study.model_sources
+    return local_sources(study.model_file)
 
 
 def output_path(study: Study, output=None) -> Path:
@@ -397,9 +404,9 @@ def shipment(study: Study, stamp: str) -> dict:
         scene = model_file.stem
     elif model_file is not None:
         home = model_file.parent
-        for path in local_imports(model_file):
+        for path, data in _sources(study).items():
             try:
-                files[path.relative_to(home).as_posix()] = path.read_bytes()
+                files[path.relative_to(home).as_posix()] = data
             except ValueError:  # outside its folder: the worker finds it as this one does
                 continue
     origin = getattr(study.model, "_origin", None)

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .._laws import Law, LawError, baumgarte, matrix, none, theorem5
-from .._loading import load_model, model_file
+from .._loading import load_model, local_sources, model_file
 from .._model import Model, ModelError
 from .._schemes import Scheme, SchemeError, as_scheme, from_tableau
 from .._sequential import Sequential
@@ -85,6 +85,10 @@ class Study:
     #: the study file's bytes as read and validated: the run key is made of them, not of
     #: the file as it may be by the time a grid point runs
     text: bytes = b""
+    #: the model file's bytes and those of the modules of its folder it imports, read
+    #: right after the model was loaded (:func:`stabdae._loading.local_sources`): the run
+    #: key and the dask workers' model are made of them
+    model_sources: dict = field(default_factory=dict)
 
     # ----------------------------------------------------------------- grid
     @property
@@ -400,12 +404,14 @@ def load_study(path, *, members: int | None = None, trust_model: bool = False) -
             refused = (f"{where}: [output] path: must lie beneath the study's folder or the "
                        f"current one, got {output!r}{via} (give another place with stabdae "
                        f"run -o)")  # fmt: skip
+    the_file = model_file(source)
     study = Study(path=path, model=model, params=params, law=law, scheme=scheme, run=run,
                   ensemble=ens, axes=axes,
                   output=None if output is None
                   else Path(os.path.normpath(path.parent / output)),
-                  model_file=model_file(source), notes=notes, search=search,
-                  output_refused=refused, text=text)  # fmt: skip
+                  model_file=the_file, notes=notes, search=search,
+                  output_refused=refused, text=text,
+                  model_sources={} if the_file is None else local_sources(the_file))  # fmt: skip
     if searching:
         return study  # τ is what the search finds: no time grid to check
 
