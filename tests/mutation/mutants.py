@@ -435,10 +435,12 @@ MUTANTS = [
            "a chunk gives a point the attributes of the chunk's first point that it lacks"),
     Mutant("run-key-without-model",
            S + "study/run.py",
-           "        for path in local_imports(study.model_file):",
-           "        for path in local_imports(study.model_file)[:0]:",
-           ('tests/study/test_run.py::test_resume_after_a_model_edit_recomputes_and_equals_a_clean_run',),
-           "the run key leaves out the model file"),
+           "    for path, data in _sources(study).items():\n"
+           "        h.update(path.name.encode()",
+           "    for path, data in list(_sources(study).items())[:0]:\n"
+           "        h.update(path.name.encode()",
+           ('tests/study/test_run.py::test_every_setting_that_decides_the_numbers_is_in_the_run_key',),
+           "the run key leaves out the model file and the modules of its folder it imports"),
     Mutant("foreign-parts-folder-used",
            S + "study/run.py",
            "    if existed and Manifest.read(parts) is None:",
