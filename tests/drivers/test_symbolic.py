@@ -354,7 +354,7 @@ def test_unexpanded_derivation_is_the_same_model_in_fewer_operations(tmp_path):
     # a chain of rods in its joint angles whose tip is held at a fixed distance from a
     # pin: a constraint that nests the angles in a square root of squared sums
     chain = load_file(ROOT / "studies" / "bench_generate.py", "stabdae_bench_generate").minimal
-    expanded = chain(3, simplify=False)
+    expanded = chain(3, simplify=False, expand=True)
     kept = chain(3, simplify=False, expand=False)
     a = stabdae.load_model(expanded.write(tmp_path / "expanded.py"))
     b = stabdae.load_model(kept.write(tmp_path / "kept.py"))
@@ -423,7 +423,8 @@ def test_a_sum_of_thousands_of_terms_is_written_as_partial_sums(tmp_path, monkey
                       lagrangian=(xd**2 + yd**2) / 2 - potential,
                       holonomic=[y - sum(x ** (i % 4) * sp.sin(i * x) / i
                                          for i in range(1, terms + 1))],
-                      params={}, reference_state=[0.0] * 4, simplify=False)  # fmt: skip
+                      params={}, reference_state=[0.0] * 4, simplify=False,
+                      expand=True)  # fmt: skip
 
     split = system().write(tmp_path / "split.py")
     monkeypatch.setattr(symbolic, "_TERMS", 10**9)
