@@ -342,6 +342,7 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
     try:
         with walls("sample"):
             x0, alpha0, status, g_ref = placed = _members(run, x0)
+            run = replace(run, noise=_noise(run, x0, status, gain))
         with walls("integrate"):
             out, band = _integrate(run, x0, alpha0, status, g_ref)
     except Exception as exc:  # a model function raised: say which, when and where
@@ -393,6 +394,7 @@ def _build(run, times, x0, alpha0, out, status, referee, peak, roundoff, verdict
         extra=run.mode.extra(out), overshoot_theory=peak, adaptive=run.adaptive,
         roundoff=roundoff, referee=referee, verdicts=verdicts,
     )  # fmt: skip
+    table.attrs["fit_roundoff_level"] = float(run.noise)
     if not run.states:
         del table.data["x0"], table.data["x_final"]
     return table
@@ -415,6 +417,9 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
         try:
             with walls("sample"):
                 x0, alpha0, status, g = placed = _members(sub, None, reference=g_ref is None)
+                if lo == 0:  # from the first members, as the one-shot ensemble's
+                    run = replace(run, noise=_noise(run, x0, status, gain))
+                sub = replace(sub, noise=run.noise)
             with walls("integrate"):
                 if g_ref is None:
                     g_ref, referee = g, _referee(run, g)
@@ -524,7 +529,7 @@ class _Fixed:
                       g.nsteps // g.save_every + 1, run.rdtype)  # fmt: skip
         R_stride = (np.linalg.matrix_power(run.R, self.stride) if run.R.size else run.R)
         measure = FixedMeasurement.of(run.divergence, g_ref, R_stride, self.stride,
-                                      run.trace_row)  # fmt: skip
+                                      run.trace_row, run.noise)  # fmt: skip
         args = (inputs(x0, alpha0, run.p, run.bound), self.grid, self.tableau, measure, out)
         progress, block = run.progress, run.block
         run_chunks(lambda lo, hi: self.kernel(*args, lo, hi), -(-M // block),
@@ -603,7 +608,7 @@ class _Lanes:
         M = x0.shape[0]
         out = self._outputs(run, x0, status)
         measure = AdaptiveMeasurement.of(run.divergence, run.R, run.h_pred, run.trace_row,
-                                         g_ref)  # fmt: skip
+                                         g_ref, run.noise)  # fmt: skip
         args = (inputs(x0, alpha0, run.p, run.bound), self.grid, self.tableau, measure, out)
         run_chunks(lambda lo, hi: self.kernel(*args, lo, hi), M, threads=run.threads,
                    progress=run.progress)  # fmt: skip
@@ -641,6 +646,7 @@ class _RunSpec:
     R: np.ndarray  # the linear prediction's one-step propagator (empty: none)
     h_pred: float  # ... and its step
     start: int = 0  # the index of the first member (of a sequential ensemble's look)
+    noise: float = 0.0  # the roundoff level the fits keep their distance from (_noise)
 
     @property
     def adaptive(self) -> bool:
@@ -982,6 +988,17 @@ def measure_stride(R) -> int:
 #: members whose final states set the roundoff level the growth test compares with
 ROUNDOFF_SAMPLE = 16
 DECISION_REASONS = messages(DecisionReason)
+
+
+def _noise(run, x0, status, gain) -> float:
+    """The roundoff level the fits keep their distance from (γ's window ends
+    ``GAMMA_MARGIN`` times above it, :func:`.engine.decay.fit.gamma_of`): as
+    :func:`_roundoff`, at the initial states of the first ``ROUNDOFF_SAMPLE`` members
+    (the same for any ensemble or look that holds them) and the run's end time (the
+    largest ``|∂g/∂t · t|``).  Known before the members run, as the kernel needs it."""
+    k = min(ROUNDOFF_SAMPLE, x0.shape[0])
+    return _roundoff(run.model, x0[:k], status[:k], run.p, float(run.t_end), gain,
+                     run.threads, run.sampled)  # fmt: skip
 
 
 def _roundoff(model, x_final, status, p, t, gain, threads, sampled=False):

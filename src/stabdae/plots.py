@@ -293,8 +293,12 @@ def decay_curves(ds: xr.Dataset, path: Path, members: int = 12) -> Path:
         ax.semilogy(t[ok], y[ok], "-", color=c, lw=1.1)
         b = float(sub["beta"].values[traced[j]])
         g = float(sub["gamma"].values[traced[j]])
-        if np.isfinite(b) and np.isfinite(g):  # only fits that exist
-            ax.semilogy(t, g * np.exp(-b * t), ":", color=c, lw=0.9)
+        if np.isfinite(b) and np.isfinite(g):  # only fits that exist, over their window
+            t0 = float(sub["time"].values[0])
+            lo = float(sub["fit_start"].values[traced[j]]) - t0
+            hi = float(sub["fit_end"].values[traced[j]]) - t0
+            span = (t >= min(lo, 0.0)) & (t <= hi)
+            ax.semilogy(t[span], g * np.exp(-b * t[span]), ":", color=c, lw=0.9)
     if "beta_theory_discrete" in sub and np.isfinite(float(sub["beta_theory_discrete"])):
         bd = float(sub["beta_theory_discrete"])
         a0 = float(np.nanmax(sub["alpha0_norm"].values))
@@ -312,7 +316,7 @@ def decay_curves(ds: xr.Dataset, path: Path, members: int = 12) -> Path:
     if data.size:
         ax.set_ylim(0.3 * data.min(), 3.0 * data.max())
     ax.plot([], [], "-", color="gray", label="‖g(t)‖∞ of a member")
-    ax.plot([], [], ":", color="gray", label="its fitted γ·exp(−βt)")
+    ax.plot([], [], ":", color="gray", label="its fitted γ·exp(−βt), over the fit's window")
     ax.set_xlabel("t − t₀ [s]")
     ax.set_ylabel("constraint residual ‖g‖∞")
     where = ", ".join(f"{d} = {float(sub[d]):g}" for d in point) or "the study"

@@ -474,3 +474,27 @@ def test_a_members_measures_do_not_depend_on_its_place_in_the_ensemble(tau):
         assert int((envelope & np.isfinite(forward["beta_predicted"])).sum()) >= 3
     for name in ("beta", "gamma", "beta_predicted", "fit_kind", "beta_reason", "x_final"):
         np.testing.assert_array_equal(forward[name].values, backward[name].values, name)
+
+
+@pytest.mark.parametrize("scheme", ["euler", "rk4"])
+def test_gamma_of_an_exact_decay_is_the_initial_norm_down_to_roundoff(scheme):
+    """On the affine system without its holonomic constraint the residual is h alone, and
+    one step maps it by the scalar ``R(−τk)`` exactly, so ``‖g_k‖ e^{βt_k} = ‖α⁰‖`` at
+    every step: γ, the largest such product over the transient, is ``‖α⁰‖`` for every
+    member, to 1e-6 (the rounding a point carries ``GAMMA_MARGIN`` times above the
+    roundoff level), though the members decay to that level within the run (the points
+    on it once set γ to ``level · e^{βt}``, 10³–10⁵ times ``‖α⁰‖``)."""
+    from models.affine import nonholonomic
+
+    ds = stabdae.ensemble(nonholonomic, stabdae.baumgarte(k=10.0), scheme, 1e-3, 3.0,
+                          members=64, seed=0)  # fmt: skip
+    ratio = ds.gamma.values / ds.alpha0_norm.values
+    assert np.isfinite(ratio).all()
+    assert np.abs(ratio - 1.0).max() < 1e-6
+    beta = ds.beta.values / ds.beta_theory_discrete.values
+    assert np.abs(beta - 1.0).max() < 1e-6
+    # the members reach the roundoff level before the end: γ's window ends above it
+    assert (ds.final_residual.values < 1e3 * ds.attrs["fit_roundoff_level"]).all()
+    t_end = ds.fit_end.values - float(ds.time.values[0])
+    assert (ds.alpha0_norm.values * np.exp(-10.0 * t_end)
+            > 0.9 * decay.fit.GAMMA_MARGIN * ds.attrs["fit_roundoff_level"]).all()  # fmt: skip

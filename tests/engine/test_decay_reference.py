@@ -88,6 +88,26 @@ def test_reference_window_follows_the_floor_margin():
     assert abs(est["beta"] / 10.0 - 1.0) < 1e-3
 
 
+def test_gamma_of_a_run_that_ends_on_its_roundoff_level_is_the_transients():
+    """A pure exponential that falls onto a roundoff plateau in the run's last fifth
+    (each fifth still below the one before, so the run reads as still decaying): with
+    the roundoff level given, γ is the exponential's prefactor ``a`` (to the plateau's
+    share at the lowest point used, 1e-6 of it), the window ends above the plateau, and
+    both are the reference's."""
+    t = np.linspace(0.0, 3.0, 3001)
+    a, rate, level = 1e-3, 10.0, 1e-15
+    wobble = 1.0 + 0.5 * np.sin(41.0 * t)
+    v = a * np.exp(-rate * t) + level * wobble
+    rec = decay.measure_traces(v[None, :], t, noise=level)
+    assert rec["reason"][0] == decay.R_FITTED
+    assert abs(rec["gamma"][0] / a - 1.0) < 2e-6
+    assert a * np.exp(-rate * rec["fit_end"][0]) > ref.ROUNDOFF_FLOOR * level
+    assert abs(rec["beta"][0] / rate - 1.0) < 1e-3
+    want = ref.estimate(t, v, level)
+    assert rec["fit_end"][0] == want["fit_end"]
+    np.testing.assert_allclose(rec["gamma"][0], want["gamma"], rtol=1e-9)
+
+
 # ------------------------------------------------------------------ random traces
 def _shape(kind, a, rate, c, omega, floor, t):
     wobble = 1.0 + 0.3 * np.sin(omega * t + 1.0)
@@ -110,20 +130,23 @@ def _shape(kind, a, rate, c, omega, floor, t):
                              "rising", "on its floor", "still decaying"]),
        a=st.floats(1e-8, 1.0), rate=st.floats(0.5, 40.0), c=st.floats(-8.0, 20.0),
        omega=st.floats(5.0, 80.0), floor=st.floats(1e-16, 1e-9),
-       samples=st.sampled_from([201, 600, 1001]))  # fmt: skip
+       samples=st.sampled_from([201, 600, 1001]),
+       noise=st.sampled_from([0.0, 1e-17, 1e-15, 1e-13]))  # fmt: skip
 @settings(max_examples=120)
-def test_random_traces_follow_the_reference(kind, a, rate, c, omega, floor, samples):
+def test_random_traces_follow_the_reference(kind, a, rate, c, omega, floor, samples, noise):
     """Random traces of every shape (decaying onto a varying floor, a repeated
     eigenvalue's ``|1 + ct| e^{−βt}``, oscillating, flat, rising, sitting on the floor,
     still decaying at the end): the fifths' largest norms, the start and the largest
     exactly; the window and the kind of fit exactly, except where the reference's own
     choice is a tie (the two fits' sums of squares, or the RMS against ``SMOOTH_RMS``,
-    within 1e-6); β to the shift searches' tolerance; no fit, no β."""
+    within 1e-6); β to the shift searches' tolerance, and γ; no fit, no β.  With a
+    roundoff level given (``noise``), the window and γ keep their documented distance
+    from it."""
     t = np.linspace(0.0, 2.0, samples)
     v = _shape(kind, a, rate, c, omega, floor, t)
     assume(np.all(v > 0) and np.all(np.isfinite(v)))
-    rec = decay.measure_traces(v[None, :], t)
-    want = ref.estimate(t, v)
+    rec = decay.measure_traces(v[None, :], t, noise=noise)
+    want = ref.estimate(t, v, noise)
     np.testing.assert_array_equal([rec[f"w{k}"][0] for k in range(5)], ref.fifths(t, v))
     assert rec["initial"][0] == v[0] and rec["largest"][0] == v.max()
     got_kind = KINDS[int(rec["fit_kind"][0])]
@@ -142,3 +165,5 @@ def test_random_traces_follow_the_reference(kind, a, rate, c, omega, floor, samp
         return
     tol = 2e-5 if want["kind"] == "polynomial" else 1e-10
     np.testing.assert_allclose(rec["beta"][0], want["beta"], rtol=tol)
+    if rec["reason"][0] == decay.R_FITTED:
+        np.testing.assert_allclose(rec["gamma"][0], want["gamma"], rtol=10 * tol)

@@ -114,3 +114,20 @@ def f_accel_forced(t, q, v, p, out):
 
 forced = model.replace(name="affine_forced", f=f_forced, f_t=f_t_forced,
                        f_accel=f_accel_forced)
+
+
+#: the same system without its holonomic constraint (m = 0, k = 1): the residual is h
+#: alone, and under ``ḣ = −k h`` one step maps it by the scalar ``R(−τk)``, so
+#: ``‖g_k‖ e^{βt_k} = ‖α⁰‖`` at every step, with ``β = −ln |R(−τk)|/τ``
+nonholonomic = stabdae.Model(
+    "affine_nonholonomic",
+    n=3,
+    m=0,
+    k=1,
+    reference_state=np.array([1.0, 0.0, 0.0, 0.5, 0.0, 0.5 / 3.0]),
+    forces=forces,
+    h=h,
+    h_q=h_q,
+    h_v=h_v,
+    h_t=h_t,
+)

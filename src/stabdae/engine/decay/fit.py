@@ -17,6 +17,7 @@ from .record import (
     C_FIT_END,
     C_FIT_START,
     C_GAMMA,
+    C_INITIAL,
     C_SHIFT,
     I_KIND,
     I_POINTS,
@@ -41,6 +42,15 @@ SMOOTH_RMS = 0.01
 GROWTH = 1.5
 #: the run ended inside the transient: each of the last three fifths fell by this factor
 STILL_DECAYING = 3.0
+#: a point of the transient enters the fits only above this many times the run's roundoff
+#: level, where the run ended still decaying (its last points may lie on that level)
+ROUNDOFF_FLOOR = 30.0
+#: γ is taken over the points above this many times the roundoff level (or, for a member
+#: that starts within ten times that of it, over its first decade): a point carries
+#: rounding errors of about that level, absolute, which move the product ``‖g‖ e^{βt}``
+#: by their ratio to ``‖g‖``; on the roundoff level itself they would set γ
+#: (``level · e^{βt}``, orders of magnitude above the transient's)
+GAMMA_MARGIN = 1e6
 N_SHIFTS = 16
 #: Brent's search for the shift stops within this fraction of its bracket (two grid steps)
 BRENT_TOL = 3e-5
@@ -290,19 +300,25 @@ def _fit_polynomial(rt, ry, start, end, dt, a, b, lg, hint=math.nan):
 
 
 @njit(cache=True, _nrt=False)
-def _window(rt, ry, n, floor, still_decaying):
+def _window(rt, ry, n, floor, still_decaying, noise=0.0):
     """The fit window ``[start, end)`` of the envelope points: the transient (down to a
-    margin above the floor, or all points when the run ended still decaying) after its
+    margin above the floor, or all points when the run ended still decaying; above
+    ``ROUNDOFF_FLOOR`` times the roundoff level ``noise`` in either case) after its
     first ``LEAD_FRACTION`` of decades.  ``end`` is 0 when no window spans
     ``MIN_DECADES`` with ``MIN_POINTS`` points."""
     lnfloor = math.log(floor) if floor > 0.0 else -math.inf
+    lnnoise = math.log(ROUNDOFF_FLOOR * noise) if noise > 0.0 else -math.inf
     for margin in (1000.0, 100.0, FLOOR_MARGIN, -1.0):
         if margin < 0.0:
             if not still_decaying:
                 break
             end = n
+            for i in range(n):
+                if ry[i] <= lnnoise:
+                    end = i
+                    break
         else:
-            level = lnfloor + math.log(margin)
+            level = max(lnfloor + math.log(margin), lnnoise)
             end = n
             for i in range(n):
                 if ry[i] <= level:
@@ -323,10 +339,10 @@ def _window(rt, ry, n, floor, still_decaying):
 
 
 @njit(cache=True, _nrt=False)
-def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code):
+def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code, noise=0.0):
     """β, γ and the fit's window, kind and shift from the ``n`` envelope points into
     ``out`` and ``code`` (a member's row of the record's floats and integers; ``reason``
-    too)."""
+    too).  ``noise``: the run's roundoff level (:func:`gamma_of`)."""
     out[C_BETA] = math.nan
     out[C_GAMMA] = math.nan
     out[C_FIT_START] = math.nan
@@ -337,7 +353,7 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code):
     if n < 2 or not math.isfinite(ry[0]):
         code[I_REASON] = R_NOT_DECAYING if n < 2 else R_NO_TRANSIENT
         return
-    start, end = _window(rt, ry, n, floor, still_decaying)
+    start, end = _window(rt, ry, n, floor, still_decaying, noise)
     if end == 0:
         # no decade of decay above the floor: growing, or started near its floor
         code[I_REASON] = (R_NOT_DECAYING if grows(out[C_D2], out[C_D3], out[C_D4])
@@ -362,13 +378,25 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code):
     if not (beta > 0.0):
         code[I_REASON] = R_NOT_DECAYING
         return
-    top = -math.inf  # the exponential is monotone: one call, on the largest exponent
-    for i in range(end):
-        top = max(top, ry[i] + beta * rt[i])
-    gamma = math.exp(top)
     out[C_BETA] = beta
-    out[C_GAMMA] = gamma
+    # (the start is a point of the transient whose level a later visit may hold)
+    out[C_GAMMA] = max(gamma_of(rt, ry, end, beta, noise), out[C_INITIAL])
     code[I_REASON] = R_FITTED
+
+
+@njit(cache=True, _nrt=False)
+def gamma_of(rt, ry, end, beta, noise):
+    """``γ = max ‖g(t)‖ e^{βt}`` over the envelope points ``[0, end)`` (``ry`` the log
+    norms) that lie above ``GAMMA_MARGIN`` times the roundoff level ``noise``, or over
+    the first decade (``MIN_DECADES``) of a member that starts within ten times that."""
+    cut = -math.inf
+    if noise > 0.0:
+        cut = min(math.log(GAMMA_MARGIN * noise), ry[0] - MIN_DECADES * math.log(10.0))
+    top = ry[0] + beta * rt[0]  # the exponential is monotone: one call, on the largest
+    for i in range(1, end):
+        if ry[i] >= cut:
+            top = max(top, ry[i] + beta * rt[i])
+    return math.exp(top)
 
 
 @njit(cache=True, _nrt=False)

@@ -99,19 +99,20 @@ def begin(lt, lv, base, meas, codes, j, row, g0, d0, clear_from=0):
 
 
 @njit(cache=True, _nrt=False)
-def finish(lt, lv, meas, codes, j, row, final, stopped, dt, rt, ry, a, b, lg):
+def finish(lt, lv, meas, codes, j, row, final, stopped, dt, rt, ry, a, b, lg, noise=0.0):
     """Member ``row``'s measures from ladder row ``j`` at the end of its run (``final``:
-    the norm at its last state; ``stopped``: it did not run to the end)."""
+    the norm at its last state; ``stopped``: it did not run to the end; ``noise``: the
+    run's roundoff level, :func:`.fit.gamma_of`)."""
     still = summarize(meas, codes, row, final, stopped)
     if not stopped:
         fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, 0,
-                     ladder_top(lt, j))  # fmt: skip
+                     ladder_top(lt, j), noise)  # fmt: skip
 
 
 @njit(cache=True)
 def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base_j, lowest, dt, rt,
                     ry, a, b, lg, ref, gen_h=0.0, floor_min=0.0, envelope=True,
-                    low_bin=0):  # fmt: skip
+                    low_bin=0, noise=0.0):  # fmt: skip
     """:func:`finish` for a member with one-step map sums ``S`` (:func:`map_estimate`,
     ``dt`` the time between the map's pairs; ``lowest`` a level below which ladder row
     ``j`` has no point; ``ref`` the law's spectrum, :func:`reference_logs`; ``gen_h > 0``:
@@ -132,14 +133,16 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
     # before it
     drift = meas[row, C_D4] * 10.0**MIN_DECADES <= meas[row, C_INITIAL]
     if grows(meas[row, C_D2], meas[row, C_D3], meas[row, C_D4]) and not drift:
-        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top)
+        fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top,
+                     noise)  # fmt: skip
         if codes[row, I_REASON] != R_NOT_DECAYING:
             map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                         top, lowest, gen_h, floor_min, low_bin)  # fmt: skip
+                         top, lowest, gen_h, floor_min, low_bin, noise)  # fmt: skip
     elif not map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, dt, rt, ry, ref,
-                          top, lowest, gen_h, floor_min, low_bin):  # fmt: skip
+                          top, lowest, gen_h, floor_min, low_bin, noise):  # fmt: skip
         if envelope:
-            fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top)
+            fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest, top,
+                         noise)  # fmt: skip
         else:
             codes[row, I_POINTS] = 0
             codes[row, I_KIND] = K_NONE
@@ -148,12 +151,12 @@ def finish_with_map(lt, lv, S, meas, codes, j, row, final, stopped, ng, pm, base
 
 @njit(cache=True, _nrt=False)
 def fit_envelope(lt, lv, meas, codes, j, row, still, dt, rt, ry, a, b, lg, lowest=0,
-                 top=NBINS - 1):  # fmt: skip
+                 top=NBINS - 1, noise=0.0):  # fmt: skip
     """β and γ of member ``row`` from the envelope of ladder row ``j`` (:func:`estimate`;
     ``still``: the run ended while it was decaying; ``lowest``, ``top``: no level below
-    the one or above the other was visited)."""
+    the one or above the other was visited; ``noise``: the run's roundoff level)."""
     n = records(lt, lv, j, rt, ry, lowest, top)
-    estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row], codes[row])
+    estimate(rt, ry, n, meas[row, C_D4], still, dt, a, b, lg, meas[row], codes[row], noise)
 
 
 @njit(cache=True, _nrt=False)

@@ -12,7 +12,7 @@ from numba import njit
 from ..fma import fma
 from ..jit import internal, variant
 from ..workspace import stack1
-from .fit import FLOOR_MARGIN, MIN_DECADES, MIN_POINTS
+from .fit import FLOOR_MARGIN, GAMMA_MARGIN, MIN_DECADES, MIN_POINTS
 from .ladder import (
     _TINY,
     LEVELS_PER_OCTAVE,
@@ -33,6 +33,7 @@ from .record import (
     C_FIT_END,
     C_FIT_START,
     C_GAMMA,
+    C_INITIAL,
     C_SHIFT,
     C_W0,
     I_KIND,
@@ -762,7 +763,7 @@ def _map_gamma(lt, lv, j, lo, top, beta, w):
 
 @njit(cache=True)
 def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, ref, top,
-                 lowest=0, gen_h=0.0, floor_min=0.0, low_bin=0):  # fmt: skip
+                 lowest=0, gen_h=0.0, floor_min=0.0, low_bin=0, noise=0.0):  # fmt: skip
     """β of member ``row`` from its one-step map, replacing the envelope's fit.
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
@@ -818,8 +819,13 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
         if not (rho < 1.0 and rho > 0.0):
             return False
         beta = -math.log(rho) / (gen_h if gen_h > 0.0 else tau)
-        gamma, t_end = _map_gamma(lt, lv, j, max(first << MAP_SHIFT, lowest), top, beta,
-                                  ry)
+        lo_g = max(first << MAP_SHIFT, lowest)
+        if noise > 0.0:  # γ from the transient: not from the levels roundoff reaches
+            cut = min(ladder_level(GAMMA_MARGIN * noise, base_j) + 1, top - per_decade)
+            lo_g = min(max(lo_g, cut), top)
+        gamma, t_end = _map_gamma(lt, lv, j, lo_g, top, beta, ry)
+        # the start is a point of the transient whose level a later visit may hold
+        gamma = max(gamma, meas[row, C_INITIAL])
         meas[row, C_BETA] = beta
         meas[row, C_GAMMA] = gamma
         meas[row, C_FIT_START] = 0.0

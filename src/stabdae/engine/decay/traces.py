@@ -17,7 +17,7 @@ from .record import Record
 
 # --------------------------------------------------------------------- stored traces
 @njit(nogil=True, cache=True)
-def _measure_rows(norms, times, meas, codes, R, alphas, lo, hi):
+def _measure_rows(norms, times, meas, codes, R, alphas, noise, lo, hi):
     lt, lv, base = ladders(1)
     rt, ry, a, b, lg = scratch()
     T = norms.shape[1]
@@ -38,13 +38,13 @@ def _measure_rows(norms, times, meas, codes, R, alphas, lo, hi):
             w = min(4, int(5.0 * (times[i] - times[0]) / span)) if span > 0.0 else 4
             observe(lt, lv, base, meas, 0, r, times[i] - times[0], v, v, w)
             last = v
-        finish(lt, lv, meas, codes, 0, r, last, stopped, dt, rt, ry, a, b, lg)
+        finish(lt, lv, meas, codes, 0, r, last, stopped, dt, rt, ry, a, b, lg, noise)
         if R.shape[0] > 0:
             predict(R, alphas, r, T - 1, dt, lt, lv, base, meas, codes, 0, r, rt, ry, a, b, lg,
                     g, gn, rho_R)  # fmt: skip
 
 
-def measure_traces(norms, times, R=None, alpha0=None):
+def measure_traces(norms, times, R=None, alpha0=None, noise=0.0):
     """The measurement record (:data:`COLUMNS`) of stored traces, each sample taken as a
     step.
 
@@ -57,6 +57,10 @@ def measure_traces(norms, times, R=None, alpha0=None):
     R, alpha0 : arrays (ng, ng) and (members, ng), optional
         The one-sample propagator of the linear prediction and each member's ``g(t_0)``:
         fills ``beta_predicted``.
+    noise : float, optional
+        The traces' roundoff level: the fits keep their distance from it (the window
+        ends ``ROUNDOFF_FLOOR`` times above it where a trace ends still decaying; γ is
+        taken ``GAMMA_MARGIN`` times above it, :func:`.fit.gamma_of`).
 
     Returns
     -------
@@ -70,5 +74,5 @@ def measure_traces(norms, times, R=None, alpha0=None):
     alphas = (np.zeros((M, 1)) if alpha0 is None
               else np.ascontiguousarray(np.atleast_2d(alpha0), dtype=np.float64))  # fmt: skip
     out = Record.empty(M)
-    run_chunks(lambda lo, hi: _measure_rows(norms, times, *out, R, alphas, lo, hi), M)
+    run_chunks(lambda lo, hi: _measure_rows(norms, times, *out, R, alphas, float(noise), lo, hi), M)
     return out

@@ -448,7 +448,7 @@ def build_block_kernel(K, spec: Spec):
         x0s, alpha0s, p, law_mat, law_scal = inputs
         t0, tau, nsteps, save_every = grid
         tab_a, tab_b, tab_c = tableau
-        threshold, g_ref, R, stride, trace_row = measure
+        threshold, g_ref, R, stride, trace_row, noise = measure
         out_norm, meas, mcodes, x_final = out.norms, out.meas, out.codes, out.x_final
         status, fail_step, e0, e1, g_out = out.status, out.fail_step, out.e0, out.e1, out.g_out
         M = x0s.shape[0]
@@ -681,7 +681,7 @@ def build_block_kernel(K, spec: Spec):
                 lowest = min(low[j] << MAP_SHIFT, ladder_level(dn_b[j], base[j]))
                 finish_member(lt, lv, S_map, meas, mcodes, j, lo + j, final, not active[j],
                               ng, pooled, base[j], lowest, stride * tau, rt, ry, fa, fb, lg,
-                              ref, low_bin=low[j])  # fmt: skip
+                              ref, low_bin=low[j], noise=noise)  # fmt: skip
                 written = lowest  # (a prediction clears the row and writes levels of its own)
                 if R.shape[0] > 0:
                     written = predict(R, alpha0s, lo + j, nsteps // stride, stride * tau, lt,

@@ -106,19 +106,22 @@ class FixedMeasurement(NamedTuple):
     ``divergence`` at a stored sample stop; the decay on ``‖g_k − g_ref[k]‖∞`` (``g_ref``
     with no rows: ``‖g_k‖∞``) at every ``stride``-th state, with the linear prediction
     ``g_{k+1} = R g_k`` over ``stride`` steps (``R`` empty: none); member ``i``'s
-    samples go to row ``trace_row[i]`` of the stored norms (−1: none)."""
+    samples go to row ``trace_row[i]`` of the stored norms (−1: none); ``noise``: the
+    run's roundoff level, from which the fits' windows keep their distance
+    (:func:`stabdae.engine.decay.fit.gamma_of`; 0: none known)."""
 
     divergence: float
     g_ref: np.ndarray
     R: np.ndarray
     stride: int
     trace_row: np.ndarray
+    noise: float
 
     @classmethod
-    def of(cls, divergence, g_ref, R, stride, trace_row) -> FixedMeasurement:
+    def of(cls, divergence, g_ref, R, stride, trace_row, noise=0.0) -> FixedMeasurement:
         return cls(float(divergence), np.ascontiguousarray(g_ref, dtype=float),
                    np.ascontiguousarray(R, dtype=float), np.int64(stride),
-                   np.ascontiguousarray(trace_row, dtype=np.int64))  # fmt: skip
+                   np.ascontiguousarray(trace_row, dtype=np.int64), float(noise))  # fmt: skip
 
 
 class AdaptiveMeasurement(NamedTuple):
@@ -132,12 +135,13 @@ class AdaptiveMeasurement(NamedTuple):
     h_pred: float
     trace_row: np.ndarray
     g_ref: np.ndarray
+    noise: float
 
     @classmethod
-    def of(cls, divergence, R, h_pred, trace_row, g_ref) -> AdaptiveMeasurement:
+    def of(cls, divergence, R, h_pred, trace_row, g_ref, noise=0.0) -> AdaptiveMeasurement:
         return cls(float(divergence), np.ascontiguousarray(R, dtype=float), float(h_pred),
                    np.ascontiguousarray(trace_row, dtype=np.int64),
-                   np.ascontiguousarray(g_ref, dtype=float))  # fmt: skip
+                   np.ascontiguousarray(g_ref, dtype=float), float(noise))  # fmt: skip
 
 
 class Outputs(NamedTuple):

@@ -209,7 +209,7 @@ def _build_adaptive_block(K, spec: Spec):
         x0, alpha0s, p, law_mat, law_scal = inputs
         t0, save_times, h0, rtol, atol, max_steps = grid
         tab_a, tab_b, tab_e, tab_c, q = tableau
-        divergence, R, h_pred, trace_row, g_ref = measure
+        divergence, R, h_pred, trace_row, g_ref, noise = measure
         NR = g_ref.shape[0]
         # the least floor of the distance from the reference, whose steps' local errors
         # differ from a member's by a share of their own size that a member's last fifth
@@ -390,7 +390,7 @@ def _build_adaptive_block(K, spec: Spec):
                     generator_store(S_g, Ag, lane, 0, low[lane])
                     finish_with_map(lt, lv, S_g, meas, mcodes, lane, i, final, st != 0, ng, PM,
                                     base[lane], 0, span / max(acc_n[lane], 1), rt, ry, fa,
-                                    fb, lg, ref, h_pred, floor_min, NR == 0)  # fmt: skip
+                                    fb, lg, ref, h_pred, floor_min, NR == 0, 0, noise)  # fmt: skip
                     if R.shape[0] > 0:
                         predict(R, alpha0s, i, int(round(span / h_pred)), h_pred, lt, lv,
                                 base, meas, mcodes, lane, i, rt, ry, fa, fb, lg, g_p,
