@@ -282,8 +282,9 @@ def test_measurement_stride_changes_no_rate(monkeypatch):
         np.testing.assert_allclose(ds.beta.values, pred, rtol=1e-3)
     np.testing.assert_allclose(strided.beta.values, every.beta.values, rtol=1e-4)
     # γ: the largest ‖g‖e^{βt} on the transient, for a Jordan block |c0 + c1 t| at the
-    # transient's end, which a stride moves by up to one stride (2 % of the window here)
-    np.testing.assert_allclose(strided.gamma.values, every.gamma.values, rtol=0.02)
+    # end of γ's window, which a stride moves by up to one stride: ωsτ/(1 + ωt_w) of γ,
+    # up to 4 % for the members whose window ends soonest (1e6 above roundoff)
+    np.testing.assert_allclose(strided.gamma.values, every.gamma.values, rtol=0.05)
     for name in ("residual_floor", "max_residual"):
         np.testing.assert_allclose(strided[name].values, every[name].values,
                                    rtol=2 * 0.2**2 / 8, err_msg=name)  # fmt: skip
@@ -293,16 +294,19 @@ def test_measurement_stride_changes_no_rate(monkeypatch):
 
 def test_map_window_of_a_member_still_decaying_ends_at_the_run_end():
     """A member whose residual still falls when the run ends (ω = 10 over 2 s: no floor
-    yet) has the whole run as its map's window: ``fit_end`` is the final time, whose
-    state is on the ladder though the stride does not measure it (s = 20 ends at step
-    1980), and γ covers it."""
+    yet) has the whole run as its map's window; ``fit_end`` is where γ's levels end
+    (``GAMMA_MARGIN`` times above the roundoff level), later the larger the member, and
+    never past the final time."""
     model = load_scene("pendulum")
     ds = stabdae.ensemble(model, stabdae.baumgarte(10, 1), "midpoint", 1e-3, 2.0,
                           members=256, radius=(1e-6, 1e-2), seed=5, traces="none")  # fmt: skip
     still = ds.floor_reached.values == 0
     assert ds.attrs["measure_every"] == 20 and still.sum() > 200
     assert set(ds.fit_kind.values[still].tolist()) == {decay.K_MAP}
-    np.testing.assert_array_equal(ds.fit_end.values[still], 2.0)
+    end = ds.fit_end.values[still]
+    assert (end > 0.0).all() and (end <= 2.0).all()
+    # the larger the member, the later it comes within the cut (all decay alike)
+    assert np.corrcoef(np.log(ds.alpha0_norm.values[still]), end)[0, 1] > 0.9
 
 
 def test_members_whose_floor_rises_keep_the_map_rate():
