@@ -28,8 +28,10 @@ from ._measures import (
     CONFIRM_FAILS,
     ENDS,
     GUIDED,
+    BRACKETED_BY_MOTION,
     HIGH_END_STABLE,
     LOW_END_FAILS,
+    LOW_END_MOTION,
     PROBE_UNDECIDED,
     STAGES,
     V_STABLE,
@@ -37,6 +39,7 @@ from ._measures import (
     VERDICTS,
     ensemble_verdict,
 )
+from ._codes import VerdictReason
 from ._schema import cf_dataset, provenance, schema_variable, variable
 from ._sequential import MIN_BATCH, Sequential
 from .engine.ensemble.block import BLOCK
@@ -133,7 +136,10 @@ def boundary(
         full ensemble's ``fraction_stable`` at ``tau_star_low`` with its Wilson interval
         and ``members_run``/``members_stable``; every probe (``probe_tau``,
         ``probe_members``, ``probe_fraction_stable``, ``probe_stable``,
-        ``probe_verdict``, ``probe_stage``); for a constant law the theory's ``tau_limit_spectral``,
+        ``probe_verdict``, ``probe_stage``, ``probe_motion_unstable``: the scheme is
+        unstable on the motion itself there, its unperturbed run diverges or leaves ε,
+        and every member is unstable; where that holds at ``tau_star_high`` or at the
+        bracket's low end, ``tau_star_reason`` says so); for a constant law the theory's ``tau_limit_spectral``,
         ``tau_limit_weighted_norm`` and ``tau_limit_floor`` (Theorems 6/7 with
         condition 4, see :func:`floor_limit`) and ``spectral_radius`` at τ*.
 
@@ -224,7 +230,9 @@ def boundary(
     v_lo, lo = probe(lo, search_members, ENDS)
     if v_lo != V_STABLE:
         good, bad = math.nan, lo
-        reason = PROBE_UNDECIDED if v_lo == V_UNDECIDED else LOW_END_FAILS
+        reason = (PROBE_UNDECIDED if v_lo == V_UNDECIDED
+                  else LOW_END_MOTION if _on_motion(probes[-1][5])
+                  else LOW_END_FAILS)  # fmt: skip
     elif (end := probe(hi, search_members, ENDS))[0] == V_STABLE:
         good, bad, reason = end[1], math.nan, HIGH_END_STABLE
     elif end[0] == V_UNDECIDED:
@@ -281,6 +289,9 @@ def boundary(
     top = min(bad, limits["tau_limit_spectral"]) if good <= limits["tau_limit_spectral"] \
         else bad  # fmt: skip
     star = math.sqrt(good * top) if reason == BRACKETED else math.nan
+    high = _last(probes, bad, None)
+    if reason == BRACKETED and high is not None and _on_motion(high):
+        reason = BRACKETED_BY_MOTION
     at = _last(probes, good, None if plan is not None else members)
     floor = (floor_limit(model, law, scheme, epsilon, steps=steps if t_end is None else None,
                          t_end=t_end, params=p, rtol=rtol,
@@ -293,6 +304,14 @@ def boundary(
         epsilon=epsilon, bracket=(lo, hi),
         confidence=math.nan if plan is None else confidence,
         probe_confidence=math.nan if plan is None else plan.confidence))  # fmt: skip
+
+
+def _on_motion(ds) -> bool:
+    """Whether a probe's scheme is unstable on the motion itself, as its members' verdicts
+    say (:func:`._measures.verdict`: the unperturbed run blew up or left ε beyond
+    roundoff, where the law's linear part is stable)."""
+    return "verdict_reason" in ds and bool(
+        (ds["verdict_reason"] == int(VerdictReason.MOTION_UNSTABLE)).any())
 
 
 def _bisect(probe, good, bad, rtol, n, stage=BISECTION):
@@ -421,6 +440,7 @@ def _dataset(model, p, law, scheme, r) -> xr.Dataset:
         "probe_stable": [np.int8(x[3] == V_STABLE) for x in probes],
         "probe_verdict": [np.int8(x[3]) for x in probes],
         "probe_stage": [np.int8(x[4]) for x in probes],
+        "probe_motion_unstable": [np.int8(_on_motion(x[5])) for x in probes],
     }  # fmt: skip
     for name, vals in columns.items():
         data[name] = schema_variable(name, np.asarray(vals), model, dims=("probe",))

@@ -205,6 +205,14 @@ class VerdictReason(_Codes):
                             "law's bound and rose over the last three fifths, but stayed "
                             "below where it started: the floor of a motion that has left "
                             "the reference's, which this run cannot tell from slow growth")
+    MOTION_UNSTABLE = 12, ("unstable on the motion itself: the unperturbed run (alpha0 = 0) "
+                           "diverges or its residual leaves epsilon, so no member can stay "
+                           "within epsilon (the dataset's reference_stop_time and "
+                           "reference_exceeds_epsilon_time say when)")
+    ROSE_IN_FLOOR_BAND = 13, ("rose in the floor band (rho < 1): the deviation grew over the "
+                              "last three fifths past its start and past the law's bound, "
+                              "but stayed within the reference trajectory's floor band: this "
+                              "run cannot tell growth from the floor's variation")
 
 
 class DecisionReason(_Codes):
@@ -231,6 +239,11 @@ class TauStarReason(_Codes):
     CONFIRM_FAILS = 3, "the full ensemble is not stable above the bracket's low end"
     UNDECIDED = 4, ("a probe could not decide (too many members undecided): tau_star_low "
                     "and tau_star_high are the last decided bracket, not narrowed to rtol")
+    LOW_END_MOTION = 5, ("unstable on the motion itself at the bracket's low end: the "
+                         "unperturbed run diverges or leaves epsilon there")
+    BRACKETED_BY_MOTION = 6, ("bracketed; at tau_star_high the scheme is unstable on the "
+                              "motion itself (the unperturbed run diverges or leaves "
+                              "epsilon), not only on the perturbations")
 
 
 class ProbeStage(_Codes):

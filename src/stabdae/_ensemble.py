@@ -24,6 +24,7 @@ import xarray as xr
 from . import _measures, theory
 from . import _validate as check
 from ._codes import DecisionReason, Status, messages
+from ._measures import Motion
 from ._ensemble_dataset import Table, _warn_stopped
 from ._ensemble_dataset import ensemble_table as _table
 from ._model import Model
@@ -344,12 +345,12 @@ def ensemble_table(model, law, scheme=None, tau=1e-3, t_end=1.0, *, rtol=None, a
             x0, alpha0, status, g_ref = placed = _members(run, x0)
             run = replace(run, noise=_noise(run, x0, status, gain))
         with walls("integrate"):
-            out, band = _integrate(run, x0, alpha0, status, g_ref)
+            out, band, motion = _integrate(run, x0, alpha0, status, g_ref)
     except Exception as exc:  # a model function raised: say which, when and where
         raise _raised_in(run, "ensemble", exc, None if placed is None else x0) from exc
     status = np.where(status != 0, status, out.status).astype(np.int8)
     with walls("dataset"):
-        referee = _referee(run, g_ref, band)
+        referee = _referee(run, g_ref, band, motion)
         roundoff = _roundoff(run.model, out.x_final, status, run.p, float(times[-1]), gain,
                              run.threads, run.sampled)  # fmt: skip
         table = _build(run, times, x0, alpha0, out, status, referee, peak, roundoff)
@@ -842,7 +843,8 @@ def _reference_residuals(model, bound, scheme, p, t0, tau, nsteps, block=BLOCK,
 
 
 def _integrate(run: _RunSpec, x0, alpha0, status, g_ref):
-    """``(out, band)``: the members' outputs, and the floor band :func:`_reference_floor`
+    """``(out, band, motion)``: the members' outputs, and the floor band and the motion
+    (:class:`._measures.Motion`) :func:`_reference_floor`
     would give where the verdicts are judged against it (no reference residuals to read
     it from; fixed steps), read from the reference state run as one more member of the
     same kernel call: members never interact, so its numbers are those of its run alone,
@@ -850,7 +852,7 @@ def _integrate(run: _RunSpec, x0, alpha0, status, g_ref):
     and where that member stopped (then its run alone, without the divergence
     threshold, gives the band as before)."""
     if run.adaptive or (g_ref is not None and g_ref.shape[0] > 1):
-        return run.mode.integrate(run, x0, alpha0, status, g_ref), None
+        return run.mode.integrate(run, x0, alpha0, status, g_ref), None, None
     M, ng = x0.shape[0], run.model.n_residual
     ref = np.asarray(run.model.reference_state(run.p), dtype=float)[None, :]
     progress = run.progress
@@ -860,36 +862,40 @@ def _integrate(run: _RunSpec, x0, alpha0, status, g_ref):
     out = run.mode.integrate(more, np.concatenate([x0, ref]),
                              np.concatenate([alpha0, np.zeros((1, ng))]),
                              np.append(status, np.int8(0)), g_ref)  # fmt: skip
-    band = None
+    band = motion = None
     if out.status[M] == 0:
         rec = Record(out.meas[M:], out.codes[M:])
         band = np.array([rec[f"w{w}"][0] for w in range(5)], dtype=float)
         if not np.isfinite(band).all():
             band = np.zeros(5)  # as :func:`_reference_floor` gives it
+        motion = Motion.of_run(0, math.nan, band, run.t0, run.t_end, run.epsilon)
     per_member = ("meas", "codes", "x_final", "status", "fail_step", "e0", "e1")
-    return out._replace(**{name: getattr(out, name)[:M] for name in per_member}), band
+    return (out._replace(**{name: getattr(out, name)[:M] for name in per_member}), band,
+            motion)
 
 
-def _referee(run: _RunSpec, g_ref, band=None) -> dict:
+def _referee(run: _RunSpec, g_ref, band=None, motion=None) -> dict:
     """What a member's verdict is judged against (:func:`._measures.verdict`): the
     reference trajectory's largest residual per fifth of the run (its truncation floor:
     from its stored residuals, or from a run of the mode's kernel on the reference state
     alone, or ``band`` where that run was read from the members' own, :func:`_integrate`),
-    and, where ``Ã`` is constant, ``ρ`` of the one-step propagator and ``sup ‖R^k‖∞`` per
-    fifth (:func:`.theory.fifth_bounds`)."""
-    if band is None:
-        band = _floor_band(run, g_ref)
+    how that run went against ε (``motion``, :class:`._measures.Motion`, from the same
+    source), and, where ``Ã`` is constant, ``ρ`` of the one-step propagator and
+    ``sup ‖R^k‖∞`` per fifth (:func:`.theory.fifth_bounds`)."""
+    if band is None or motion is None:
+        band, motion = _floor_band(run, g_ref)
     if run.R.shape[0] == 0:
-        return dict(floor_band=band, bounds=None, rho=math.nan, divergence=run.divergence)
+        return dict(floor_band=band, bounds=None, rho=math.nan, divergence=run.divergence,
+                    motion=motion)  # fmt: skip
     rho = float(np.max(np.abs(np.linalg.eigvals(run.R))))
     return dict(floor_band=band, bounds=theory.fifth_bounds(run.R, run.mode.prediction_steps),
-                rho=rho, divergence=run.divergence)  # fmt: skip
+                rho=rho, divergence=run.divergence, motion=motion)  # fmt: skip
 
 
-def _floor_band(run: _RunSpec, g_ref) -> np.ndarray:
-    """The reference trajectory's largest residual per fifth of the run: from its stored
-    residuals ``g_ref``, or where there are none from a run of the reference state alone
-    (:func:`_reference_floor`)."""
+def _floor_band(run: _RunSpec, g_ref) -> tuple[np.ndarray, Motion]:
+    """The reference trajectory's largest residual per fifth of the run and how it went
+    against ε (:class:`._measures.Motion`): from its stored residuals ``g_ref``, or where
+    there are none from a run of the reference state alone (:func:`_reference_floor`)."""
     if g_ref is None or g_ref.shape[0] <= 1:
         return _reference_floor(run)
     if run.adaptive:  # rows (t, g) at the reference's accepted steps, fifths by time
@@ -898,15 +904,18 @@ def _floor_band(run: _RunSpec, g_ref) -> np.ndarray:
         norms = np.abs(g_ref[:, 1:]).max(axis=1)
     else:
         nsteps = g_ref.shape[0] - 1
+        t = run.t0 + run.mode.grid.tau * np.arange(nsteps + 1)
         fifth = np.minimum(4, (5 * np.arange(nsteps + 1)) // nsteps)
         norms = np.abs(np.asarray(g_ref, dtype=float)).max(axis=1)
-    return np.array([norms[fifth == w].max(initial=0.0) for w in range(5)])
+    band = np.array([norms[fifth == w].max(initial=0.0) for w in range(5)])
+    return band, Motion.of_rows(t, norms, run.epsilon)
 
 
-def _reference_floor(run: _RunSpec) -> np.ndarray:
+def _reference_floor(run: _RunSpec) -> tuple[np.ndarray, Motion]:
     """The largest residual per fifth of the run of the model's reference state alone
     (``α⁰ = 0``), measured as the members' (5 numbers; zeros where it did not run to the
-    end)."""
+    end), and how that run went against ε (:class:`._measures.Motion`: with no
+    divergence threshold, it stops only where it blew up)."""
     x0 = run.model.reference_state(run.p)[None, :]
     one = replace(run, trace_row=np.full(1, -1), traced=np.zeros(0, dtype=np.int64),
                   progress=None, divergence=math.inf, threads=1)  # fmt: skip
@@ -914,9 +923,14 @@ def _reference_floor(run: _RunSpec) -> np.ndarray:
                              np.zeros(1, dtype=np.int8), np.zeros((0, run.model.n_residual)))
     rec = Record(out.meas, out.codes)
     band = np.array([rec[f"w{w}"][0] for w in range(5)], dtype=float)
-    if out.status[0] != 0 or not np.isfinite(band).all():
-        return np.zeros(5)
-    return band
+    status = int(out.status[0])
+    if status == 0 and not np.isfinite(band).all():
+        status = int(Status.NONFINITE_STATE)
+    stopped = (run.t0 + run.mode.grid.tau * int(out.fail_step[0])
+               if status and not run.adaptive and out.fail_step[0] >= 0 else math.nan)
+    if status != 0:
+        band = np.zeros(5)
+    return band, Motion.of_run(status, stopped, band, run.t0, run.t_end, run.epsilon)
 
 
 def _trace_rows(traces, members: int, who: str, first: bool = False):

@@ -139,6 +139,11 @@ def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, trace
         "status": status,
         **summary,
     }
+    motion = (referee or {}).get("motion")
+    if motion is not None:  # how the unperturbed run went (per grid point in a study)
+        values.update(reference_status=np.int8(motion.status),
+                      reference_stop_time=float(motion.stopped_at),
+                      reference_exceeds_epsilon_time=float(motion.exceeds_at))  # fmt: skip
     if R.shape[0] > 0:
         beta_pred = meas["beta_predicted"]
         values["beta_predicted"] = beta_pred
@@ -168,7 +173,9 @@ def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, trace
     attrs["comment"] = f"stored as {norms.dtype}; " + attrs["comment"]
     data["stability_radius"][2]["comment"] = radius_why
     attrs = provenance(model, p, law, scheme, f"ensemble of {x0.shape[0]} members", **run)
-    attrs["verdict_summary"] = _measures.verdict_summary(verdicts, why, cls != _measures.NOT_RUN)
+    attrs["verdict_summary"] = _measures.verdict_summary(
+        verdicts, why, cls != _measures.NOT_RUN,
+        "" if motion is None else motion.describe(epsilon))  # fmt: skip
     if referee is not None:
         attrs["reference_floor"] = np.asarray(referee["floor_band"], dtype=float)
     attrs["roundoff_level"] = float(roundoff)

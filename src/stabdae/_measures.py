@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import stats
@@ -70,7 +71,11 @@ Z95 = 1.959963984540054
 
 #: codes of a boundary search's ``tau_star_reason`` (:class:`stabdae._codes.TauStarReason`)
 BRACKETED, LOW_END_FAILS, HIGH_END_STABLE, CONFIRM_FAILS, PROBE_UNDECIDED = (
-    int(c) for c in TauStarReason)
+    int(TauStarReason.BRACKETED), int(TauStarReason.LOW_END_FAILS),
+    int(TauStarReason.HIGH_END_STABLE), int(TauStarReason.CONFIRM_FAILS),
+    int(TauStarReason.UNDECIDED))
+LOW_END_MOTION, BRACKETED_BY_MOTION = (int(TauStarReason.LOW_END_MOTION),
+                                       int(TauStarReason.BRACKETED_BY_MOTION))
 TAU_STAR_REASONS = messages(TauStarReason)
 #: a boundary search's probe stages (``probe_stage``, :class:`stabdae._codes.ProbeStage`)
 ENDS, GUIDED, BISECTION, CONFIRM = (int(c) for c in ProbeStage)
@@ -95,6 +100,7 @@ FLOOR_BAND = 10.0
 TRANSIENT_SLACK = 2.0
 
 _BLOWN_UP = (Status.DIVERGED, Status.NONFINITE_STATE, Status.SINGULAR_S, Status.MASS_NOT_SPD)
+_BLOWN_UP_CODES = frozenset(int(s) for s in _BLOWN_UP)
 
 
 def blown_up(status: np.ndarray) -> np.ndarray:
@@ -153,9 +159,84 @@ def classify(meas: decay.Record, status: np.ndarray, epsilon: float,
     return cls
 
 
+@dataclass(frozen=True)
+class Motion:
+    """How the unperturbed run (``α⁰ = 0``, the reference trajectory) went: its status
+    (a :class:`~stabdae._codes.Status` code, 0: it ran to the end), the time it stopped
+    (NaN: it did not, or the time is not known), and the first time its residual
+    exceeded ε (NaN: never; ``by_fifth``: known only as the end of the fifth of the run
+    in which it did).
+
+    Where it blew up or left ε the scheme is unstable on the motion itself: no member can
+    stay within ε (Definition 2 of the paper asks that of every member), and the
+    reference's residual, which the members' deviations are read against, is no floor.
+    :func:`verdict` then calls every member that ran unstable, with one reason, unless
+    the run's residual can reach ε by roundoff alone (:meth:`leaves_epsilon`)."""
+
+    status: int = 0
+    stopped_at: float = math.nan
+    exceeds_at: float = math.nan
+    by_fifth: bool = False
+    epsilon: float = math.inf
+
+    @property
+    def unstable(self) -> bool:
+        return self.status in _BLOWN_UP_CODES or math.isfinite(self.exceeds_at)
+
+    def leaves_epsilon(self, roundoff: float) -> bool:
+        """Whether the motion is unstable beyond what roundoff explains: it blew up, or its
+        residual exceeded ε where ε lies above ``roundoff``, the size roundoff builds up
+        in the residual by the end of the run (states that grow without bound carry a
+        roundoff that grows with them: its reaching ε says that the arithmetic, not the
+        scheme, cannot hold the motion within ε)."""
+        return self.status in _BLOWN_UP_CODES or (math.isfinite(self.exceeds_at)
+                                                  and not roundoff >= self.epsilon)
+
+    @classmethod
+    def of_rows(cls, times, norms, epsilon: float) -> Motion:
+        """From the reference's residual norms ``norms`` at ``times``, a run to the end."""
+        over = np.flatnonzero(~(np.asarray(norms, dtype=float) <= epsilon))
+        return cls(exceeds_at=float(times[over[0]]) if over.size else math.nan,
+                   epsilon=float(epsilon))
+
+    @classmethod
+    def of_run(cls, status: int, stopped_at: float, band, t0: float, t_end: float,
+               epsilon: float) -> Motion:  # fmt: skip
+        """From a run's status, the time it stopped and its largest residual per fifth
+        (``band``; zeros where it stopped)."""
+        over = np.flatnonzero(~(np.asarray(band, dtype=float) <= epsilon))
+        if int(status) != 0 or not over.size:
+            return cls(int(status), float(stopped_at) if int(status) else math.nan,
+                       epsilon=float(epsilon))
+        return cls(exceeds_at=t0 + (int(over[0]) + 1) * (t_end - t0) / 5.0, by_fifth=True,
+                   epsilon=float(epsilon))
+
+    @classmethod
+    def of_dataset(cls, ds) -> Motion:
+        """From an ensemble's dataset (its ``reference_*`` variables; a stable motion where
+        it has none)."""
+        if "reference_status" not in ds:
+            return cls()
+        return cls(int(ds["reference_status"]), float(ds["reference_stop_time"]),
+                   float(ds["reference_exceeds_epsilon_time"]))  # fmt: skip
+
+    def describe(self, epsilon: float) -> str:
+        """What happened, in the words of a summary (empty where the motion is stable)."""
+        if not self.unstable:
+            return ""
+        if self.status in _BLOWN_UP_CODES:
+            when = (f"at t = {self.stopped_at:.6g}" if math.isfinite(self.stopped_at)
+                    else "before the end")  # fmt: skip
+            return f"the unperturbed run diverges {when} ({Status(self.status).short})"
+        word = "by" if self.by_fifth else "at"
+        return (f"the unperturbed run's residual exceeds epsilon = {epsilon:g} {word} "
+                f"t = {self.exceeds_at:.6g}")
+
+
 def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None,
             rho: float = math.nan, divergence: float = math.inf,
-            roundoff: float = 0.0) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+            roundoff: float = 0.0, motion: Motion | None = None
+            ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Each member's verdict and its reason (int8 codes of :data:`VERDICTS` and
     :data:`VERDICT_REASONS`).
 
@@ -173,7 +254,11 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
       which then referees.
 
     With the theory and ``ρ < 1``: *stable* where the deviation over the last fifth lies
-    within ``TRANSIENT_SLACK`` times the law's bound plus the floor band; *unstable* only
+    within ``TRANSIENT_SLACK`` times the law's bound plus the floor band, unless it rose
+    over the last three fifths past its start and past the law's bound alone, by more
+    than ``GROWTH`` times what the reference's floor rose over the same fifths (then
+    *undecided*: growth inside the floor band cannot be told from the floor's variation;
+    a grown member is never stable); *unstable* only
     where it blew up past what the bound allows, or rose over the last three fifths
     (:func:`stabdae.engine.decay.grows`) beyond the bound and past its own start (a rise
     that stays below the start is the floor of a motion that has left the reference's:
@@ -182,7 +267,12 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
     ``ρ ≥ 1``: *unstable* where it blew up or grew; a member that decayed is undecided
     (the growing mode may lie under the floor).  Without the theory: *unstable* where it
     blew up, or grew above the floor band and its start; *stable* where it ended below
-    its start; *undecided* otherwise (in the floor band, or the run too short)."""
+    its start; *undecided* otherwise (in the floor band, or the run too short).
+
+    ``motion`` (:class:`Motion`): where the unperturbed run itself blew up or left ε,
+    every member that ran is *unstable* on the motion itself, whatever its deviation
+    (unless ``ρ ≥ 1``: there the law's growing mode takes the reference with it; and
+    unless ``roundoff`` alone reaches ε, :meth:`Motion.leaves_epsilon`)."""
     R_ = VerdictReason
     d0 = np.asarray(meas["initial"], dtype=float)
     d2, d3, d4 = (np.asarray(meas[c], dtype=float) for c in ("d2", "d3", "d4"))
@@ -214,6 +304,18 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
         put(~within & grew & ~past_start, V_UNDECIDED, R_.ROSE_BELOW_START)
         put(within & ~ended_low, V_STABLE, R_.WITHIN_BOUND)
         put(within & ended_low, V_STABLE, R_.DECAYED)
+        # a deviation that rose past the law's bound alone and past its start, faster
+        # than the reference's floor rose over the same fifths, has grown, though the
+        # floor band may still hold it (a floor's variation from member to member, the
+        # floor's dependence on the state times the member's offset from the reference's,
+        # rises with the floor itself)
+        floor_rise = band[4] / band[2] if band[2] > 0.0 and band[4] > 0.0 else 1.0
+        with np.errstate(invalid="ignore"):
+            law_bound = (TRANSIENT_SLACK * np.asarray(bounds, dtype=float)[4] * d0
+                         + ROUNDOFF_MARGIN * roundoff)  # fmt: skip
+            rose = (resolved & decay.grows(d2, d3, d4) & past_start & (d4 > law_bound)
+                    & (d4 > decay.GROWTH * max(1.0, floor_rise) * d2))  # fmt: skip
+        put(within & rose, V_UNDECIDED, R_.ROSE_IN_FLOOR_BAND)
     elif theory_known:
         # ρ ≥ 1: the reference trajectory's own residual grows with the law's growing
         # mode, so it is no floor; growth past the member's start is evidence enough
@@ -235,6 +337,11 @@ def verdict(meas: decay.Record, status: np.ndarray, floor_band=None, bounds=None
         with np.errstate(invalid="ignore"):
             excused = (status == int(Status.DIVERGED)) & (divergence <= peak)
         put(excused, V_UNDECIDED, R_.STOPPED_IN_TRANSIENT)
+    if (motion is not None and motion.leaves_epsilon(roundoff)
+            and not (theory_known and rho >= 1.0)):
+        # (with ρ ≥ 1 the law's own growing mode takes the reference with it: the law,
+        # not the motion, is unstable, and the members say so by their own growth)
+        put((status == 0) | blown, V_UNSTABLE, R_.MOTION_UNSTABLE)
     put((status != 0) & ~blown, V_UNDECIDED, R_.NOT_RUN)
     return verdict, reason
 
@@ -383,9 +490,10 @@ def ensemble_verdict(n_run: int, n_stable: int, n_unstable: int, q: float = 0.0)
     return V_UNDECIDED
 
 
-def verdict_summary(verdicts, reasons, ran) -> str:
+def verdict_summary(verdicts, reasons, ran, motion: str = "") -> str:
     """One line a user reads first: the counts of each verdict, the undecided and the
-    unstable by reason."""
+    unstable by reason (``motion``: what happened to the unperturbed run where the
+    scheme is unstable on the motion itself, :meth:`Motion.describe`)."""
     n = int(ran.sum())
     parts = []
     for v, name in VERDICTS.items():
@@ -394,7 +502,10 @@ def verdict_summary(verdicts, reasons, ran) -> str:
         text = f"{k} {name}"
         if k and v != V_STABLE:
             why = np.unique(reasons[sel], return_counts=True)
-            text += " (" + "; ".join(f"{c} {VERDICT_REASONS[int(r)].split(':')[0]}"
-                                     for r, c in zip(*why)) + ")"  # fmt: skip
+            text += " (" + "; ".join(
+                f"{c} {VERDICT_REASONS[int(r)].split(':')[0]}"
+                + (f": {motion}" if motion and int(r) == int(VerdictReason.MOTION_UNSTABLE)
+                   else "")
+                for r, c in zip(*why)) + ")"  # fmt: skip
         parts.append(text)
     return f"of {n} members that ran: " + ", ".join(parts)

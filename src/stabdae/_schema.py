@@ -183,6 +183,15 @@ SCHEMA: dict[str, tuple] = {
     "members_unstable": ((), "unstable members", "1", {}),
     "members_undecided": ((), "undecided members", "1", {}),
     "members_with_beta": ((), "members with a measured beta", "1", {}),
+    "reference_status": ((), "status of the unperturbed run (alpha0 = 0), the reference "
+                         "trajectory", "1", flag_attrs(Status)),
+    "reference_stop_time": ((), "time at which the unperturbed run stopped (NaN: it ran to "
+                            "the end, or the time is not known)", "s", {}),
+    "reference_exceeds_epsilon_time": ((), "first time the unperturbed run's residual "
+                                       "exceeded epsilon (NaN: never, or not measured "
+                                       "where it blew up); where set, or where it blew up, "
+                                       "the scheme is unstable on the motion itself", "s",
+                                       {}),
     # --- the theorems' predictions (ensemble, study grid)
     "beta_theory": ((), "continuous decay rate -max Re eig(A~) (Theorem 3)", "s-1", {}),
     "beta_theory_discrete": ((), "discrete decay rate -ln rho(R(tau A~))/tau", "s-1", {}),
@@ -217,6 +226,9 @@ SCHEMA: dict[str, tuple] = {
     "probe_stable": ("probe", "the probe counted as stable (fraction at least 1 - q)", "1",
                      _FLAG),
     "probe_stage": ("probe", "stage of the search", "1", flag_attrs(ProbeStage)),
+    "probe_motion_unstable": ("probe", "the scheme is unstable on the motion itself at the "
+                              "probe (its unperturbed run diverges or leaves epsilon)", "1",
+                              _FLAG),
     "lambda_min_W": ((), "min eigenvalue of W = h_v h_v^T over x0 and x_final", "1", {}),
     "beta_theorem5_proven": ((), "Theorem 5 rate k0 lambda_min(W) l1^2/lm (proven)", "s-1",
                              {}),
@@ -268,7 +280,8 @@ _GROUPS = (
         "stability_radius_reason", "beta_median", "beta_median_low", "beta_median_high",
         "beta_median_coverage", "beta_ratio_median", "members_run", "members_stable",
         "members_unstable", "members_undecided", "members_bounded", "members_diverged",
-        "members_growing", "members_with_beta", "decision", "decision_reason",
+        "members_growing", "members_with_beta", "reference_status", "reference_stop_time",
+        "reference_exceeds_epsilon_time", "decision", "decision_reason",
         "decision_low", "decision_high", "members_used",
         "overshoot_theory", "beta_theory", "beta_theory_discrete",
         "spectral_radius", "norm_max", "norm_weighted", "norm_condition", "lambda_min_W",
@@ -289,7 +302,7 @@ _GROUPS = (
         "members_unstable", "members_undecided", "members_diverged", "members_growing",
         "tau_limit_spectral", "tau_limit_weighted_norm", "tau_limit_floor", "spectral_radius",
         "probe_tau", "probe_members", "probe_fraction_stable", "probe_stable",
-        "probe_verdict", "probe_stage")),
+        "probe_verdict", "probe_stage", "probe_motion_unstable")),
     ("Theorems 6/7 along a trajectory: `theory.along_path` (the variables drop the `path_` "
      "prefix)", ("path_spectral_radius", "path_norm_max", "path_norm_2", "path_norm_weighted",
                  "path_remainder", "path_residual_norm", "path_q", "path_bound_start")),
@@ -357,7 +370,7 @@ def schema_markdown() -> str:
 _CODE_VARIABLES = (("status", Status), ("beta_reason", BetaReason), ("fit_kind", FitKind),
                    ("verdict", Verdict), ("verdict_reason", VerdictReason),
                    ("decision", Verdict), ("decision_reason", DecisionReason),
-                   ("stability_class", StabilityClass),
+                   ("stability_class", StabilityClass), ("reference_status", Status),
                    ("stability_radius_reason", RadiusReason),
                    ("tau_star_reason", TauStarReason), ("probe_stage", ProbeStage),
                    ("delta_star_reason", ProfileReason))  # fmt: skip

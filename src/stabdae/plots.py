@@ -114,6 +114,34 @@ def _outline(ax, mask, xe, ye, **style):
                   ls=style.get("ls", "-"))
 
 
+def motion_unstable(ds: xr.Dataset):
+    """Per grid point, whether the scheme is unstable on the motion itself: a member's
+    verdict says so (``verdict_reason`` ``motion_unstable``, where the unperturbed run
+    blew up or left ε beyond roundoff); None for a dataset without verdicts."""
+    from ._codes import VerdictReason
+
+    if "verdict_reason" not in ds or "member" not in ds["verdict_reason"].dims:
+        return None
+    return (ds["verdict_reason"] == int(VerdictReason.MOTION_UNSTABLE)).any("member")
+
+
+def _hatch_motion(ax, sub, xd, yd, xe, ye):
+    """Hatch the cells where the scheme is unstable on the motion itself; the legend's
+    handle, or None where there is no such cell."""
+    bad = motion_unstable(sub)
+    if bad is None or not bool(bad.any()):
+        return None
+    import matplotlib.patches as mpatches
+
+    for j, i in zip(*np.nonzero(bad.transpose(yd, xd).values)):
+        ax.add_patch(mpatches.Rectangle((xe[i], ye[j]), xe[i + 1] - xe[i], ye[j + 1] - ye[j],
+                                        fill=False, hatch="xx", edgecolor="black",
+                                        linewidth=0.0, alpha=0.45))  # fmt: skip
+    return mpatches.Patch(facecolor="none", edgecolor="black", hatch="xx",
+                          label="unstable on the motion itself (unperturbed run diverges "
+                                "or leaves ε)")  # fmt: skip
+
+
 def _first_of_others(ds, keep):
     sel = {d: 0 for d in _sweep_dims(ds) if d not in keep}
     note = ", ".join(f"{d} = {float(ds[d][0]):g}" for d in sel)
@@ -152,6 +180,9 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
             line = _outline(ax, holds, xe, ye, **style)
             if line is not None:
                 handles.append((line, label))
+        hatched = _hatch_motion(ax, sub, xd, yd, xe, ye)
+        if hatched is not None:
+            handles.append((hatched, hatched.get_label()))
         if handles:
             leg = ax.legend(*zip(*handles), loc="upper right", framealpha=0.9, fontsize=8.5)
             leg.set_title("theory: holds inside the outline", prop={"size": 8.5})
@@ -167,6 +198,12 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
         x = ds[xd].values
         ax.plot(x, ds[_fraction(ds)].values, "o-",
                 label=_fraction(ds).replace("_", " ") + " (measured)")
+        bad = motion_unstable(ds)
+        if bad is not None and bool(bad.any()):
+            pick = bad.values
+            ax.plot(x[pick], ds[_fraction(ds)].values[pick], "kx", ms=10,
+                    label="unstable on the motion itself (unperturbed run diverges or "
+                          "leaves ε)")  # fmt: skip
         if "spectral_radius" in ds:
             rho = ds["spectral_radius"].values
             ax.plot(x, np.minimum(rho, 2.0), "s--", color="gray", label="ρ(R(τÃ)) (theory)")
@@ -219,6 +256,10 @@ def decision_map(ds: xr.Dataset, path: Path) -> Path:
                 axes[0].text(cx, cy, "?", ha="center", va="center", fontsize=9)
     handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in colors.colors]
     labels = ["stable (≤ q unstable)", "unstable (> q)", "undecided (?)"]
+    hatched = _hatch_motion(axes[0], sub, xd, yd, xe, ye)
+    if hatched is not None:
+        handles.append(hatched)
+        labels.append(hatched.get_label())
     if "spectral_radius" in sub:
         holds = sub["spectral_radius"].transpose(yd, xd).values < 1.0
         for ax in axes:

@@ -211,8 +211,11 @@ def test_adaptive_reference_records_every_accepted_step():
     assert table.shape == (one.attrs["steps_accepted"] + 1, 1 + model.n_residual)
     np.testing.assert_array_equal(np.abs(table[[0, -1], 1:]).max(axis=1),
                                   one.residual_norm.values)
-    band = _ensemble._referee(run, table)["floor_band"]
-    np.testing.assert_array_equal(band, _ensemble._reference_floor(run))
+    referee = _ensemble._referee(run, table)
+    band, motion = _ensemble._reference_floor(run)
+    np.testing.assert_array_equal(referee["floor_band"], band)
+    # the same run, read from its rows or from its fifths: within ε, ran to the end
+    assert not referee["motion"].unstable and referee["motion"] == motion
 
 
 def test_adaptive_ensemble_isolates_divergence():

@@ -399,14 +399,17 @@ def test_reference_floor_read_beside_the_members_is_its_run_alone(members, diver
                       3, True)  # fmt: skip
     x0, alpha0, status, g_ref = E._members(run, x0)
     assert g_ref.shape[0] == 0
-    out, band = E._integrate(run, x0, alpha0, status, g_ref)
-    alone = E._reference_floor(run)
+    out, band, motion = E._integrate(run, x0, alpha0, status, g_ref)
+    alone, alone_motion = E._reference_floor(run)
     if divergence is None:
         assert band is not None and (band > 0).all()
         np.testing.assert_array_equal(band, alone)
+        assert motion == alone_motion and not motion.unstable
     else:
-        assert band is None and (out.status != 0).all()
-    np.testing.assert_array_equal(E._referee(run, g_ref, band)["floor_band"], alone)
+        assert band is None and motion is None and (out.status != 0).all()
+    referee = E._referee(run, g_ref, band, motion)
+    np.testing.assert_array_equal(referee["floor_band"], alone)
+    assert referee["motion"] == alone_motion
     plain = run.mode.integrate(replace(run, progress=None), x0, alpha0, status, g_ref)
     for name in plain._fields:
         np.testing.assert_array_equal(getattr(out, name), getattr(plain, name), err_msg=name)

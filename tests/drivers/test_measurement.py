@@ -150,8 +150,8 @@ def test_stability_classes():
     law's own transient, yet every one is stable; the unstable law f̈ = 5f over 3 s: no
     member stable (over 1 s, a few started close to the decaying direction are still
     decaying at the end: e^{−√5 t} has not yet given way to e^{√5 t});
-    radii 1e-12 … 1e-10: none diverges; ε below the floor: floor above ε; τ past the
-    spectral limit: diverged."""
+    radii 1e-12 … 1e-10: none diverges; ε below the floor: unstable on the motion itself;
+    τ past the spectral limit: diverged."""
     from stabdae._measures import CLASSES
 
     model = load_scene("pendulum")
@@ -173,8 +173,12 @@ def test_stability_classes():
     assert int(tiny.members_diverged) == 0 and float(tiny.fraction_stable) == 1.0
     # they start below the midpoint rule's floor (about 7e-6 here): they never decayed
     assert (tiny.stability_class.values == CLASSES.index("at_floor")).all()
+    # ε below the midpoint rule's floor: the unperturbed run itself leaves ε, so no
+    # member can stay within it (Definition 2): unstable on the motion, on its floor
     low = ens(stabdae.baumgarte(10, 1), 1e-3, 2.0, epsilon=1e-7)
-    assert CLASSES.index("floor_above_epsilon") in low.stability_class.values
+    assert (low.verdict_reason.values == int(VerdictReason.MOTION_UNSTABLE)).all()
+    assert 0.0 < float(low.reference_exceeds_epsilon_time) < 2.0
+    assert (low.stability_class.values == CLASSES.index("growing")).all()
     with pytest.warns(stabdae.IntegrationWarning):
         bad = ens(stabdae.baumgarte(10, 1), 0.25, 20.0)
     assert (bad.stability_class.values == CLASSES.index("diverged")).all()

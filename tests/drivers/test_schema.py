@@ -103,7 +103,8 @@ RATES = {"beta", "beta_predicted", "beta_median", "beta_median_low", "beta_media
          "beta_theorem5_printed", "theorem5_beta_proven", "theorem5_beta_printed"}  # fmt: skip
 TIMES = {"fit_start", "fit_end", "tau_star", "tau_star_low", "tau_star_high", "probe_tau",
          "tau_limit_spectral", "tau_limit_max_norm", "tau_limit_two_norm",
-         "tau_limit_weighted_norm", "tau_limit_floor"}  # fmt: skip
+         "tau_limit_weighted_norm", "tau_limit_floor", "reference_stop_time",
+         "reference_exceeds_epsilon_time"}  # fmt: skip
 RESIDUALS = {"residual_norm", "alpha0_norm", "gamma", "residual_floor", "max_residual",
              "final_residual", "stability_radius", "stability_radius_low",
              "stability_radius_high", "gamma_theorem5", "path_epsilon", "path_remainder",

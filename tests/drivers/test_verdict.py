@@ -69,6 +69,57 @@ def test_verdict_rule_with_the_theory():
                                   else V_UNSTABLE] * 2 + [V_UNSTABLE, V_UNDECIDED]  # fmt: skip
 
 
+def test_a_member_that_grew_inside_the_floor_band_is_never_stable():
+    """ρ < 1, the law's transient over (bound 1e-12 by the last fifth), floor band 10 ×
+    1e-2: a deviation that rose 4× over the last three fifths, past its start, while the
+    reference's floor stayed flat, has grown inside the band: undecided, never stable.
+    The same rise beside a floor that rose 4× too is the floor's variation (stable); a
+    rise that stays below its start is no growth past it (stable); twice the floor's rise
+    is growth again."""
+    bounds = np.array([1.0, 1e-3, 1e-6, 1e-9, 1e-12])
+    flat, rising = np.full(5, 1e-2), np.array([1e-2, 1e-2, 1e-2, 2e-2, 4e-2])
+    rec = _record(np.array([1e-4, 1e-3]), np.array([1e-4, 1e-4]), np.array([2e-4, 2e-4]),
+                  np.array([4e-4, 4e-4]))  # fmt: skip
+    status = np.zeros(2, dtype=np.int8)
+    v, r = verdict(rec, status, flat, bounds, rho=0.9)
+    assert v.tolist() == [V_UNDECIDED, V_STABLE]
+    assert r.tolist() == [R_.ROSE_IN_FLOOR_BAND, R_.DECAYED]
+    v, r = verdict(rec, status, rising, bounds, rho=0.9)
+    assert v.tolist() == [V_STABLE, V_STABLE]
+    faster = _record(np.array([1e-4]), np.array([1e-4]), np.array([4e-4]), np.array([8e-4]))
+    v, r = verdict(faster, status[:1], rising, bounds, rho=0.9)
+    assert (v[0], r[0]) == (V_UNDECIDED, R_.ROSE_IN_FLOOR_BAND)
+
+
+def test_every_member_is_unstable_where_the_unperturbed_run_is():
+    """Where the unperturbed run blew up or left ε, every member that ran is unstable on
+    the motion itself, whatever its deviation did (decayed, stopped in the law's
+    transient); members not placed stay not run; a run that only ran out of steps is no
+    evidence."""
+    from stabdae._measures import Motion
+
+    bounds = np.full(5, 2.0)
+    rec = _record(np.array([1e-3, 1e-3, 1e-3]), np.array([1e-4, 1e-4, 1e-4]),
+                  np.array([1e-5, 1e-5, 1e-5]), np.array([1e-6, 1e-6, 1e-6]))  # fmt: skip
+    status = np.array([0, 4, 5], dtype=np.int8)
+    kw = dict(floor_band=np.zeros(5), bounds=bounds, rho=0.9, divergence=1e-3)
+    v, r = verdict(rec, status, **kw)
+    assert r.tolist() == [R_.DECAYED, R_.STOPPED_IN_TRANSIENT, R_.NOT_RUN]
+    for motion in (Motion(int(Status.NONFINITE_STATE), 3.64), Motion(exceeds_at=0.83)):
+        v, r = verdict(rec, status, motion=motion, **kw)
+        assert v.tolist() == [V_UNSTABLE, V_UNSTABLE, V_UNDECIDED]
+        assert r.tolist() == [R_.MOTION_UNSTABLE, R_.MOTION_UNSTABLE, R_.NOT_RUN]
+    v, r = verdict(rec, status, motion=Motion(int(Status.MAX_STEPS)), **kw)
+    assert r.tolist() == [R_.DECAYED, R_.STOPPED_IN_TRANSIENT, R_.NOT_RUN]
+    line = verdict_summary(np.full(3, V_UNSTABLE, dtype=np.int8),
+                           np.full(3, int(R_.MOTION_UNSTABLE), dtype=np.int8),
+                           np.ones(3, dtype=bool),
+                           Motion(int(Status.NONFINITE_STATE), 3.64).describe(0.1))
+    assert "3 unstable on the motion itself: the unperturbed run diverges at t = 3.64" in line
+    assert (Motion(exceeds_at=1.0, by_fifth=True).describe(0.1)
+            == "the unperturbed run's residual exceeds epsilon = 0.1 by t = 1")
+
+
 def test_verdict_rule_at_rho_above_one_and_without_theory():
     """ρ ≥ 1: growth past the start is unstable (the reference's own residual grows too,
     so the floor band is no bar), a member that decayed is undecided, never stable.
@@ -174,6 +225,53 @@ def test_unstable_law_is_never_stable():
     unstable = ds.verdict.values == V_UNSTABLE
     assert unstable.mean() > 0.9
     assert set(ds.verdict_reason.values[unstable].tolist()) <= {int(R_.GREW), int(R_.BLEW_UP)}
+
+
+def test_where_the_unperturbed_run_diverges_every_member_says_so():
+    """The pendulum under the midpoint rule and Baumgarte's law at two points where
+    ρ(R) < 1 but the scheme does not keep the motion itself: (τ, ω) = (0.04, 44.81),
+    where the unperturbed run becomes non-finite before 5 s, and (0.25, 6.694), where its
+    residual leaves ε = 1 within the run.  Every member is unstable with the one reason,
+    the dataset says when, and the summary line says it too; a grid point run until
+    decided is decided unstable at its first look.  A boundary search over ω = 44.81
+    brackets τ* below a step where the motion diverges, and says so."""
+    from stabdae._measures import Motion
+
+    pendulum = load_scene("pendulum")
+    kw = dict(members=32, radius=(1e-8, 1e-3), epsilon=1.0, seed=1, traces="none")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stabdae.IntegrationWarning)
+        blown = stabdae.ensemble(pendulum, stabdae.baumgarte(44.81), "midpoint", 0.04, 5.0,
+                                 **kw)  # fmt: skip
+        left = stabdae.ensemble(pendulum, stabdae.baumgarte(6.694), "midpoint", 0.25, 5.0,
+                                **{**kw, "members": {"q": 0.05, "batch": 16, "max": 64}})
+    for ds in (blown, left):
+        assert float(ds.spectral_radius) < 1.0
+        assert (ds.verdict.values == V_UNSTABLE).all()
+        assert (ds.verdict_reason.values == int(R_.MOTION_UNSTABLE)).all()
+        assert Motion.of_dataset(ds).unstable
+        assert "unstable on the motion itself: the unperturbed run" in ds.attrs["verdict_summary"]
+    assert int(blown.reference_status) == int(Status.NONFINITE_STATE)
+    stop = float(blown.reference_stop_time)
+    assert 0.0 < stop < 5.0 and abs(stop / 0.04 - round(stop / 0.04)) < 1e-9
+    assert f"diverges at t = {stop:.6g}" in blown.attrs["verdict_summary"]
+    # the residual the run stored leaves ε where the dataset says it does
+    assert int(left.reference_status) == 0 and int(left.decision) == V_UNSTABLE
+    assert int(left.members_used) == 16
+    out = float(left.reference_exceeds_epsilon_time)
+    ref = stabdae.integrate(pendulum, law=stabdae.baumgarte(6.694), scheme="midpoint",
+                            tau=0.25, t_end=5.0)  # fmt: skip
+    first = np.flatnonzero(ref.residual_norm.values > 1.0)[0]
+    assert out == pytest.approx(float(ref.time[first]), abs=1e-12)
+    b = stabdae.boundary(pendulum, stabdae.baumgarte(44.81), "midpoint", tau=(1e-3, 0.3),
+                         t_end=5.0, members=32, search_members=16, radius=(1e-8, 1e-3),
+                         epsilon=1.0, seed=1, rtol=0.05)  # fmt: skip
+    assert int(b.tau_star_reason) == int(stabdae._codes.TauStarReason.BRACKETED_BY_MOTION)
+    assert float(b.tau_star_low) < float(b.tau_star) < float(b.tau_star_high)
+    high = np.flatnonzero(b.probe_tau.values == float(b.tau_star_high))
+    assert b.probe_motion_unstable.values[high].all()
+    motion = b.probe_motion_unstable.values == 1
+    assert (b.probe_verdict.values[motion] == V_UNSTABLE).all()
 
 
 @pytest.mark.parametrize("scheme", ["euler", "midpoint", "heun", "rk4"])

@@ -73,14 +73,19 @@ def members(draw):
     or the rule's own thresholds for those settings and their neighbours (the noise
     level, the allowed deviation, the law's peak, growth by exactly 1.5)."""
     n = draw(st.integers(1, 24))
-    band = draw(st.none() | st.lists(value.filter(lambda x: not math.isinf(x)),
-                                     min_size=5, max_size=5))  # fmt: skip
+    finite = value.filter(lambda x: not math.isinf(x))
+    # any band, or a floor that rises over the last three fifths (where a deviation that
+    # rises with it is the floor's variation)
+    band = draw(st.none() | st.lists(finite, min_size=5, max_size=5)
+                | st.tuples(finite, positive).map(lambda xr: [xr[0]] * 3
+                                                  + [xr[0] * (1 + xr[1])] * 2))  # fmt: skip
     theory = draw(st.booleans())
     bounds = draw(st.lists(positive, min_size=5, max_size=5)) if theory else None
     rho = draw(st.sampled_from([0.5, 0.999, 1.0, 1.5]) | st.floats(0.0, 2.0)) if theory \
         else math.nan
-    roundoff = draw(st.sampled_from([0.0, 0.01, 0.1]) | st.floats(0.0, 1.0))
     epsilon = draw(positive)
+    # roundoff also at ε and beside it (whether the motion's leaving ε is roundoff's)
+    roundoff = draw(st.sampled_from([0.0, 0.01, 0.1] + _near(epsilon)) | st.floats(0.0, 1.0))
     b = [0.0 if band is None or math.isnan(x) else x for x in (band or [0.0] * 5)]
     noise = [ref.FLOOR_BAND * x + ref.ROUNDOFF_MARGIN * roundoff for x in b]
     cols = {c: np.empty(n) for c in ("initial", "d2", "d3", "d4", "largest", "w2", "w3",
@@ -91,10 +96,14 @@ def members(draw):
         marks = _near(noise[0]) + _near(noise[4]) + _near(d0)
         if theory:
             marks += _near(ref.TRANSIENT_SLACK * bounds[4] * d0 + noise[4])
+            marks += _near(ref.TRANSIENT_SLACK * bounds[4] * d0
+                           + ref.ROUNDOFF_MARGIN * roundoff)  # fmt: skip
             peaks += _near(ref.TRANSIENT_SLACK * max(bounds) * d0 + max(noise))
         d4 = draw(value | st.sampled_from(marks))
+        rise = ref.GROWTH * max(1.0, b[4] / b[2] if b[2] > 0 and b[4] > 0 else 1.0)
         d3 = draw(value | st.sampled_from(_near(d4) + _near(d4 / ref.GROWTH)))
-        d2 = draw(value | st.sampled_from(_near(d3) + _near(d4 / ref.GROWTH)))
+        d2 = draw(value | st.sampled_from(_near(d3) + _near(d4 / ref.GROWTH)
+                                          + _near(d4 / rise)))  # fmt: skip
         w4 = draw(value | st.sampled_from(_near(epsilon)))
         w3 = draw(value | st.sampled_from(_near(ref.STILL_DECAYING * w4)))
         w2 = draw(value | st.sampled_from(_near(ref.STILL_DECAYING * w3)))
@@ -104,7 +113,10 @@ def members(draw):
     status = np.array(draw(st.lists(st.sampled_from(STATUSES), min_size=n, max_size=n)),
                       dtype=np.int8)  # fmt: skip
     divergence = draw(st.sampled_from([math.inf, 1.0, 3.0, 9.0] + peaks) | st.floats(1e-3, 1e3))
-    return cols, status, band, bounds, rho, divergence, roundoff, epsilon
+    # the unperturbed run: mostly none or fine, else blown up, out of steps, or above ε
+    motion = draw(st.sampled_from([None, (0, math.nan), (0, math.nan), (3, math.nan),
+                                   (4, math.nan), (7, math.nan), (0, 0.5)]))  # fmt: skip
+    return cols, status, band, bounds, rho, divergence, roundoff, epsilon, motion
 
 
 @given(members())
@@ -112,15 +124,19 @@ def test_verdict_and_class_are_the_references(case):
     """Every member's verdict, reason and class is the reference's, for random members
     (lattice values with ties, the rule's thresholds and their neighbours, the unmeasured
     −inf, NaN, every status), with and without the theory, ρ on both sides of 1, any floor
-    band, divergence threshold and roundoff."""
-    cols, status, band, bounds, rho, divergence, roundoff, epsilon = case
+    band, divergence threshold and roundoff, and an unperturbed run that ran, blew up,
+    ran out of steps or left ε."""
+    cols, status, band, bounds, rho, divergence, roundoff, epsilon, motion = case
     v, r = _measures.verdict(cols, status, band, None if bounds is None else np.array(bounds),
-                             rho=rho, divergence=divergence, roundoff=roundoff)  # fmt: skip
+                             rho=rho, divergence=divergence, roundoff=roundoff,
+                             motion=None if motion is None
+                             else _measures.Motion(motion[0], math.nan, motion[1],
+                                                   epsilon=epsilon))  # fmt: skip
     cls = _measures.classify(cols, status, epsilon, v)
     for j in range(status.size):
         want_v, want_r = ref.verdict(cols["initial"][j], cols["d2"][j], cols["d3"][j],
                                      cols["d4"][j], status[j], band, bounds, rho, divergence,
-                                     roundoff)  # fmt: skip
+                                     roundoff, *(motion or (0, math.nan)), epsilon)  # fmt: skip
         assert (v[j], r[j]) == (want_v, want_r), j
         want_c = ref.stability_class(cols["initial"][j], cols["largest"][j], cols["w2"][j],
                                      cols["w3"][j], cols["w4"][j], status[j], epsilon,

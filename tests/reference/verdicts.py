@@ -9,13 +9,19 @@ library shows.
 
 *Verdict*, in this order of precedence (the first that applies):
 
-1. not run (status not 0 and not a blow-up): undecided, ``not run``;
+1. not run (status not 0 and not a blow-up): undecided, ``not run``; where the
+   unperturbed run blew up (its status a blow-up) or its residual exceeded ε (a time at
+   which it did) while ε lies above ``roundoff``, unless the theory has ``ρ ≥ 1``, every
+   other member: unstable, ``motion unstable``;
 2. blown up (diverged, non-finite, singular ``S``, mass not SPD): unstable, ``blew up``;
    except, with the theory and ``ρ < 1``, a member stopped by the divergence threshold
    when the threshold lies within the law's peak (``2 · max bound · d0`` + the largest
    noise): undecided, ``stopped in transient``;
 3. with the theory and ``ρ < 1``, ``allowed = 2 · bound_4 · d0 + noise_4``:
-   within it (``d4 ≤ allowed``) stable, ``decayed`` if ``d4 < d0`` else ``within bound``;
+   within it (``d4 ≤ allowed``): undecided, ``rose in floor band``, where it grew, past
+   its start, past ``2 · bound_4 · d0 + 10 · roundoff`` and past ``1.5 · max(1,
+   floor_4 / floor_2) · d2`` (the ratio 1 where either floor is 0); else stable,
+   ``decayed`` if ``d4 < d0`` else ``within bound``;
    beyond it, ``beyond bound`` (unstable) if it grew (resolved, growth, ``d4 > noise_4``)
    past its start (``d4 > d0``), ``rose below start`` (undecided) if it grew but not past
    its start, else ``above bound`` (undecided);
@@ -57,8 +63,11 @@ def grows(d2: float, d3: float, d4: float) -> bool:
 
 
 def verdict(d0, d2, d3, d4, status, floor_band=None, bounds=None, rho=math.nan,
-            divergence=math.inf, roundoff=0.0) -> tuple[int, int]:  # fmt: skip
-    """One member's ``(verdict, reason)``."""
+            divergence=math.inf, roundoff=0.0, motion_status=0,
+            motion_exceeds=math.nan, epsilon=math.inf) -> tuple[int, int]:  # fmt: skip
+    """One member's ``(verdict, reason)``; ``motion_status`` and ``motion_exceeds``: the
+    unperturbed run's status and the time its residual exceeded ``epsilon`` (NaN:
+    never)."""
     band = [0.0] * 5 if floor_band is None else [0.0 if math.isnan(b) else b
                                                   for b in floor_band]  # fmt: skip
     noise = [FLOOR_BAND * b + ROUNDOFF_MARGIN * roundoff for b in band]
@@ -67,6 +76,10 @@ def verdict(d0, d2, d3, d4, status, floor_band=None, bounds=None, rho=math.nan,
     blown = status in {int(s) for s in BLOWN_UP}
     if status != 0 and not blown:
         return V.UNDECIDED, R.NOT_RUN
+    law_grows = bounds is not None and math.isfinite(rho) and rho >= 1.0
+    left = not math.isnan(motion_exceeds) and roundoff < epsilon
+    if (int(motion_status) in {int(s) for s in BLOWN_UP} or left) and not law_grows:
+        return V.UNSTABLE, R.MOTION_UNSTABLE
     if blown:
         if theory and rho < 1.0 and status == Status.DIVERGED:
             peak = TRANSIENT_SLACK * max(bounds) * d0 + max(noise)
@@ -77,6 +90,11 @@ def verdict(d0, d2, d3, d4, status, floor_band=None, bounds=None, rho=math.nan,
     rising = resolved and grows(d2, d3, d4)
     if theory and rho < 1.0:
         if d4 <= TRANSIENT_SLACK * bounds[4] * d0 + noise[4]:
+            floor_rise = band[4] / band[2] if band[2] > 0 and band[4] > 0 else 1.0
+            if (rising and d4 > d0 and d4 > TRANSIENT_SLACK * bounds[4] * d0
+                    + ROUNDOFF_MARGIN * roundoff
+                    and d4 > GROWTH * max(1.0, floor_rise) * d2):  # fmt: skip
+                return V.UNDECIDED, R.ROSE_IN_FLOOR_BAND
             return V.STABLE, (R.DECAYED if d4 < d0 else R.WITHIN_BOUND)
         if rising and d4 > noise[4]:
             return (V.UNSTABLE, R.BEYOND_BOUND) if d4 > d0 else (V.UNDECIDED,

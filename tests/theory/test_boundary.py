@@ -16,6 +16,7 @@ from models.affine import model as affine
 from stabdae import theory
 from stabdae._measures import (
     BRACKETED,
+    BRACKETED_BY_MOTION,
     CLASSES,
     CONFIRM_FAILS,
     HIGH_END_STABLE,
@@ -51,14 +52,19 @@ def test_boundary_of_the_pendulum_lies_between_the_floor_and_the_spectral_limit(
     """The pendulum's remainder (its quadratic constraint, and the local error of the stiff
     stabilization term) loses stability before ρ = 1; Theorems 6/7 with condition 4
     guarantee ‖g‖ ≤ ε only up to where the floor the local error forces reaches ε.  RK4
-    (which damps the pendulum's own swing) over long runs."""
+    (which damps the pendulum's own swing) over long runs.  Just past τ* the unperturbed
+    run's own residual leaves ε (or the run blows up): the search says its bracket ends
+    on the motion, and no stable probe was unstable on it."""
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)
     ds = stabdae.boundary(model, law, "rk4", tau=(1e-3, 0.3), rtol=1e-2, members=64,
                           search_members=16, radius=(1e-8, 1e-3), epsilon=1.0)  # fmt: skip
     star, floor = float(ds.tau_star), float(ds.tau_limit_floor)
     spectral = float(ds.tau_limit_spectral)
-    assert int(ds.tau_star_reason) == BRACKETED
+    assert int(ds.tau_star_reason) == BRACKETED_BY_MOTION
+    probe_tau, on_motion = ds.probe_tau.values, ds.probe_motion_unstable.values == 1
+    assert on_motion[probe_tau == float(ds.tau_star_high)].all()
+    assert not on_motion[ds.probe_stable.values == 1].any()
     assert 0 < floor < float(ds.tau_star_low) and float(ds.tau_star_high) < spectral
     assert float(ds.tau_star_high) <= float(ds.tau_star_low) * 1.01
     assert 0.5 * spectral < star

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .._codes import Status, Verdict, VerdictReason
+from .._codes import Status, TauStarReason, Verdict, VerdictReason
+from .._measures import Motion
 
 VERDICT_WORDS = {int(v): v.message for v in Verdict}
 
@@ -67,18 +68,24 @@ def summary(ds: xr.Dataset) -> str:
     if "tau_star" in ds:
         cols = ["tau_star", "tau_star_low", "tau_star_high", "tau_limit_floor",
                 "tau_limit_spectral", "spectral_radius", "fraction_stable"]  # fmt: skip
+        cols += ["tau_star_reason"] if "tau_star_reason" in ds else []
         short = {"tau_star": "tau*", "tau_star_low": "low", "tau_star_high": "high",
                  "tau_limit_floor": "tau_floor", "tau_limit_spectral": "tau_spectral",
-                 "spectral_radius": "rho(tau*)", "fraction_stable": "stable"}  # fmt: skip
+                 "spectral_radius": "rho(tau*)", "fraction_stable": "stable",
+                 "tau_star_reason": "how"}  # fmt: skip
         head = ("boundary (tau*: largest stable step, between low (stable with the full "
                 "ensemble) and high; tau_floor: Theorems 6/7 with the floor the local error "
-                "forces; tau_spectral: rho(R) = 1):")  # fmt: skip
+                "forces; tau_spectral: rho(R) = 1; how: tau_star_reason, "
+                "bracketed_by_motion: at high the unperturbed run itself diverges or "
+                "leaves epsilon):")  # fmt: skip
         if "tau_star_confidence" in ds and np.isfinite(ds.tau_star_confidence.values).any():
             conf = float(np.nanmin(ds.tau_star_confidence.values))
             head = head[:-2] + (f"; the probes decided at confidence {conf:g} all together: "
                                 "the boundary lies between low and high with at least that "
                                 "probability):")  # fmt: skip
-        return "\n" + head + "\n" + grid_table(ds, cols, short, precise=cols[:5]) + "\n"
+        return "\n" + head + "\n" + grid_table(
+            ds, cols, short, precise=cols[:5],
+            codes={"tau_star_reason": {int(c): c.name.lower() for c in TauStarReason}}) + "\n"
     cols = [c for c in ("decision", "members_used",
                         "fraction_stable", "fraction_unstable", "fraction_undecided",
                         "fraction_bounded",
@@ -107,6 +114,14 @@ def summary(ds: xr.Dataset) -> str:
     return "\n" + head + "\n" + table + "\n" + unstable_below_one(ds)
 
 
+def _epsilon(ds: xr.Dataset, arrays: dict, i: int) -> float:
+    """ε at the ``i``-th grid point: swept (``run.epsilon``) or the study's one."""
+    for name in ("run.epsilon", "epsilon"):
+        if name in arrays:
+            return float(arrays[name][i])
+    return float(ds.attrs.get("epsilon", np.nan))
+
+
 def unstable_below_one(ds: xr.Dataset) -> str:
     """A note per grid point whose law is stable in the linear theory (``ρ(R) < 1``) but
     whose members are not all stable: how many are unstable, and why (the counts of
@@ -115,7 +130,8 @@ def unstable_below_one(ds: xr.Dataset) -> str:
         return ""
     dims = list(ds.spectral_radius.dims)
     flat = ds[["spectral_radius", "verdict", "verdict_reason"]
-              + (["status"] if "status" in ds else [])]
+              + [v for v in ("status", "reference_status", "reference_stop_time",
+                             "reference_exceeds_epsilon_time") if v in ds]]  # fmt: skip
     flat = flat.stack(point=dims) if dims else flat.expand_dims(point=[0])
     lines, singular = [], False
     # every variable's values with the point first, once (not xarray's indexing per point)
@@ -145,6 +161,12 @@ def unstable_below_one(ds: xr.Dataset) -> str:
                 k = [int(r) for r in reasons].index(int(VerdictReason.BLEW_UP))
                 why[k] += ": " + ", ".join(f"{c} {Status(int(s)).short}"
                                            for s, c in zip(how, many))  # fmt: skip
+        if int(VerdictReason.MOTION_UNSTABLE) in reasons and "reference_status" in arrays:
+            k = [int(r) for r in reasons].index(int(VerdictReason.MOTION_UNSTABLE))
+            motion = Motion(int(arrays["reference_status"][i]),
+                            float(arrays["reference_stop_time"][i]),
+                            float(arrays["reference_exceeds_epsilon_time"][i]))
+            why[k] += ": " + motion.describe(_epsilon(ds, arrays, i))
         why = "; ".join(why)
         lines.append(f"  {where}: rho(R) = {rho:.4g} < 1, yet {int(unstable.sum())} of "
                      f"{ran} members unstable ({why})")
