@@ -61,7 +61,8 @@ pytest.approx = _approx_that_can_fail
 ROOT = Path(__file__).resolve().parents[1]
 KERNELS = ROOT / "kernels"
 
-#: every scene of kernels/, the registry tests parametrize over
+#: the scenes of kernels/ the per-scene tests parametrize over (the small ones, one of each
+#: kind of constraint; the coupled mechanisms have tests of their own)
 SCENES = [
     "pendulum",
     "double_pendulum",

@@ -6,7 +6,12 @@ the initial states (:func:`sample_perturbations`, the compiled sampler of
 with ``rtol``, the per-member adaptive kernel (:mod:`.engine.ensemble.lanes`) over chunks of
 members on threads, each chunk's traces fitted (:mod:`.engine.decay`) by the thread that
 integrated them, and builds the dataset (:mod:`._ensemble_dataset`) beside the theorems'
-predictions (:mod:`.theory`).
+predictions (:mod:`.theory`).  Each member's verdict (:func:`._measures.verdict`) is read
+against the unperturbed run (``α⁰ = 0``): its residual per fifth of the run is the floor
+band, and how it went against ε (:class:`._measures.Motion`) says whether the scheme is
+unstable on the motion itself; that run is one more member of the same kernel call where
+it can be, a run of its own otherwise.  With a decision plan (``confidence``) the members
+run in looks of growing size until the grid point is decided (:mod:`._sequential`).
 """
 
 from __future__ import annotations

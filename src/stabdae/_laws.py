@@ -41,7 +41,8 @@ class BoundLaw:
     Attributes
     ----------
     code : int
-        Compile-time kind (constant, Theorem 5, user).
+        Compile-time kind, a :class:`~stabdae._codes.LawKind` (constant, Theorem 5, user,
+        Ascher–Chin–Petzold–Reich, constant of scalar blocks).
     matrix : float64[:, :]
         Constant ``A`` (r × (m + r)) for constant laws; ``L`` (k × k) for Theorem 5; an
         unused 1×1 array for user laws.

@@ -443,7 +443,8 @@ class Model:
 
     def check(self, params=None, *, states: int = 3, radius: float = 1e-2, seed: int = 0,
               rtol: float = 1e-6, velocity=None):  # fmt: skip
-        """Compare the derivative pieces with finite differences; see :func:`stabdae.check`."""
+        """Compare the derivative pieces with finite differences (:func:`._check.check_model`:
+        what is compared, at which states, and the report it returns)."""
         return check_model(self, params, states=states, radius=radius, seed=seed, rtol=rtol,
                            velocity=velocity)  # fmt: skip
 

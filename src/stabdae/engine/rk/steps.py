@@ -13,7 +13,9 @@ They must give the same bits for the same state (the tests
   ensemble kernel's member loop on small models (:mod:`stabdae.engine.ensemble.block`;
   on larger ones the kernel's block step goes stage by stage, its twin there).
 
-The multiply-adds are fused (:mod:`stabdae.engine.fma`) at the same places in all three,
+The multiply-adds are fused (:mod:`stabdae.engine.fma`) at the same places in every form
+(the looped step, the written-out and the looped member step, :func:`_looped_member_step`,
+and the block kernel's stage-by-stage step),
 zero coefficients are skipped, sums start from −0.0 and ``1 · k`` is ``k``.  Changing one
 step, or adding a kind of coefficient to :func:`tableau_pattern` (today zero, one,
 other), means changing all alike: the same terms skipped, the same products fused, in the
