@@ -493,6 +493,39 @@ def test_summary_names_unstable_members_where_the_law_is_stable():
     assert "linear part is stable" not in summary(calm)
 
 
+def test_summary_lists_each_undecided_point_with_its_reasons():
+    """Below the table, a line per grid point whose decision is undecided: its decision
+    reason and its undecided members' verdict reasons, the most frequent first (ties by
+    code), over the members it ran; none for a decided point, and no section where every
+    point is decided."""
+    from stabdae._codes import DecisionReason, Status, Verdict, VerdictReason
+    from stabdae.study.report import summary
+
+    S, U, D = int(Verdict.STABLE), int(Verdict.UNSTABLE), int(Verdict.UNDECIDED)
+    T, A, N = (int(VerdictReason.TOO_SHORT), int(VerdictReason.ABOVE_BOUND),
+               int(VerdictReason.NOT_RUN))  # fmt: skip
+    verdict = np.array([[S, S, S, S, S], [D, D, D, S, D], [D, U, U, U, D]], dtype=np.int8)
+    reason = np.array([[0] * 5, [A, T, A, 0, N], [T, 0, 0, 0, T]], dtype=np.int8)
+    status = np.zeros((3, 5), dtype=np.int8)
+    status[1, 4] = int(Status.NOT_NEEDED)  # not run: left out of the counts
+    decision = np.array([S, D, D], dtype=np.int8)
+    why = np.array([int(DecisionReason.STABLE), int(DecisionReason.MEMBERS_UNDECIDED),
+                    int(DecisionReason.MAX_REACHED)], dtype=np.int8)  # fmt: skip
+    ds = xr.Dataset({"verdict": (("run.tau", "member"), verdict),
+                     "verdict_reason": (("run.tau", "member"), reason),
+                     "status": (("run.tau", "member"), status),
+                     "decision": ("run.tau", decision), "decision_reason": ("run.tau", why),
+                     "fraction_stable": ("run.tau", (verdict == S).mean(axis=1))},
+                    coords={"run.tau": [0.01, 0.02, 0.04]})  # fmt: skip
+    text = summary(ds)
+    notes = text.split("undecided grid points")[1].splitlines()[1:]
+    assert [n for n in notes if n.strip()] == [
+        "  tau = 0.02: members undecided (3 of 4 members undecided: 2 above the law's "
+        "bound but not growing (rho < 1); 1 too short)",
+        "  tau = 0.04: max members reached (2 of 5 members undecided: 2 too short)"]
+    assert "undecided grid points" not in summary(ds.isel({"run.tau": [0]}))
+
+
 def test_summary_says_which_blown_up_members_met_a_singular_constraint_matrix():
     """Members that blew up are counted by how they stopped; where some stopped at a
     singular S (the constraints lost rank: the theorems assume they do not), the note

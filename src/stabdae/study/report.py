@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .._codes import Status, TauStarReason, Verdict, VerdictReason
+from .._codes import DecisionReason, Status, TauStarReason, Verdict, VerdictReason
 from .._measures import Motion
 
 VERDICT_WORDS = {int(v): v.message for v in Verdict}
@@ -111,7 +111,7 @@ def summary(ds: xr.Dataset) -> str:
             "linear prediction's beta; beta_pred = -ln rho(R)/tau):")  # fmt: skip
     table = grid_table(ds, cols, short, flags=("norm_condition",),
                        codes={"decision": VERDICT_WORDS})
-    return "\n" + head + "\n" + table + "\n" + unstable_below_one(ds)
+    return "\n" + head + "\n" + table + "\n" + unstable_below_one(ds) + undecided_points(ds)
 
 
 def _epsilon(ds: xr.Dataset, arrays: dict, i: int) -> float:
@@ -179,3 +179,43 @@ def unstable_below_one(ds: xr.Dataset) -> str:
                   "constraints lose rank, which the theorems exclude")
     return (f"\nunstable where the law's linear part is stable (rho(R) < 1: {cause}):\n"
             + "\n".join(lines) + "\n")
+
+
+def undecided_points(ds: xr.Dataset) -> str:
+    """A note per grid point whose decision is undecided: its ``decision_reason`` (where
+    the point was run until decided) and its undecided members' ``verdict_reason`` counts,
+    the most frequent first, over the members it ran; empty where every point is
+    decided."""
+    if not {"decision", "verdict", "verdict_reason"} <= set(ds.variables):
+        return ""
+    dims = list(ds.decision.dims)
+    names = ["decision", "verdict", "verdict_reason"] + [
+        v for v in ("decision_reason", "status") if v in ds]
+    flat = ds[names].stack(point=dims) if dims else ds[names].expand_dims(point=[0])
+    arrays = {k: flat[k].transpose("point", ...).values for k in flat.variables
+              if k in flat.data_vars or k in dims}  # fmt: skip
+    lines = []
+    for i in range(flat.sizes["point"]):
+        if int(arrays["decision"][i]) != int(Verdict.UNDECIDED):
+            continue
+        where = ", ".join(f"{d.split('.', 1)[-1]} = {float(arrays[d][i]):.4g}"
+                          for d in dims)  # fmt: skip
+        verdict = arrays["verdict"][i]
+        ran = np.ones(verdict.shape, dtype=bool)
+        if "status" in arrays:  # (a grid point run until decided: its own members only)
+            ran = arrays["status"][i] != int(Status.NOT_NEEDED)
+        undecided = ran & (verdict == int(Verdict.UNDECIDED))
+        reasons, counts = np.unique(arrays["verdict_reason"][i][undecided],
+                                    return_counts=True)  # fmt: skip
+        order = np.lexsort((reasons, -counts))
+        why = "; ".join(f"{counts[k]} {VerdictReason(int(reasons[k])).message.split(':')[0]}"
+                        for k in order)  # fmt: skip
+        head = (DecisionReason(int(arrays["decision_reason"][i])).message.split(":")[0]
+                if "decision_reason" in arrays else "undecided")  # fmt: skip
+        tail = f": {why}" if why else ""
+        lines.append(f"  {where}: {head} ({int(undecided.sum())} of {int(ran.sum())} "
+                     f"members undecided{tail})")
+    if not lines:
+        return ""
+    return ("\nundecided grid points (the decision's reason; the undecided members' "
+            "verdict_reason):\n" + "\n".join(lines) + "\n")
