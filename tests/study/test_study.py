@@ -493,6 +493,29 @@ def test_summary_names_unstable_members_where_the_law_is_stable():
     assert "linear part is stable" not in summary(calm)
 
 
+def test_summary_gives_delta_star_as_censored_with_its_bracket():
+    """δ* in the summary: its value with the bracket where the sample brackets it, a
+    censored ``> low`` where every decided member was stable, ``< high`` where none was
+    below the smallest unstable, ``none`` without a decided member."""
+    from stabdae._codes import RadiusReason
+    from stabdae.study.report import summary
+
+    nan = np.nan
+    ds = xr.Dataset({"fraction_stable": ("run.tau", [0.5, 1.0, 0.0, nan]),
+                     "stability_radius": ("run.tau", [2e-4, nan, nan, nan]),
+                     "stability_radius_low": ("run.tau", [1e-4, 1e-3, nan, nan]),
+                     "stability_radius_high": ("run.tau", [4e-4, nan, 1e-8, nan]),
+                     "stability_radius_reason": ("run.tau", np.array(
+                         [int(r) for r in (RadiusReason.BRACKETED, RadiusReason.ABOVE_SAMPLE,
+                                           RadiusReason.BELOW_SAMPLE, RadiusReason.NO_MEMBER)],
+                         dtype=np.int8))},
+                    coords={"run.tau": [0.01, 0.02, 0.04, 0.08]})  # fmt: skip
+    rows = summary(ds).strip().splitlines()[1:]
+    assert rows[0].split()[-1] == "delta*"
+    cells = [r.split("  ")[-1].strip() for r in rows[1:5]]
+    assert cells == ["0.0002 [0.0001, 0.0004]", "> 0.001", "< 1e-08", "none"]
+
+
 def test_summary_lists_each_undecided_point_with_its_reasons():
     """Below the table, a line per grid point whose decision is undecided: its decision
     reason and its undecided members' verdict reasons, the most frequent first (ties by

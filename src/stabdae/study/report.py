@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .._codes import DecisionReason, Status, TauStarReason, Verdict, VerdictReason
+from .._codes import DecisionReason, RadiusReason, Status, TauStarReason, Verdict, VerdictReason
 from .._measures import Motion
 
 VERDICT_WORDS = {int(v): v.message for v in Verdict}
@@ -33,22 +33,45 @@ def format_table(ds: xr.Dataset, columns=None) -> str:
                       precise=("norm_weighted", "spectral_radius", "path_norm_weighted_max"))
 
 
+def _censored(values: dict, c: str, i: int) -> str:
+    """A censored statistic ``c`` (δ*) as read: its value with its bracket, ``> low`` or
+    ``< high`` where the sample bounds it from one side only, ``none`` where it holds no
+    decided member (``c_low``, ``c_high``, ``c_reason``, :class:`RadiusReason`)."""
+    low, high = float(values[f"{c}_low"][i]), float(values[f"{c}_high"][i])
+    why = int(values[f"{c}_reason"][i])
+    if why == int(RadiusReason.BRACKETED):
+        return f"{float(values[c][i]):.4g} [{low:.4g}, {high:.4g}]"
+    if why == int(RadiusReason.ABOVE_SAMPLE):
+        return f"> {low:.4g}"
+    if why == int(RadiusReason.BELOW_SAMPLE):
+        return f"< {high:.4g}"
+    return "none"
+
+
 def grid_table(ds: xr.Dataset, columns, short: dict, *, flags=(), precise=(),
-               codes=None) -> str:  # fmt: skip
+               codes=None, censored=()) -> str:  # fmt: skip
     """One row per grid point of ``ds`` (its swept dimensions first, then ``columns``,
     headed by ``short`` names): ``flags`` as yes/no, ``codes`` (column → {code: word}) as
-    words, ``precise`` with 6 digits (the ones that decide "< 1"), the rest with 4."""
+    words, ``censored`` as :func:`_censored` reads them (where ``ds`` holds their bracket
+    and reason), ``precise`` with 6 digits (the ones that decide "< 1"), the rest with
+    4."""
     codes = codes or {}
+    censored = [c for c in censored if c in columns
+                and all(f"{c}_{s}" in ds for s in ("low", "high", "reason"))]
+    extra = [f"{c}_{s}" for c in censored for s in ("low", "high", "reason")]
     dims = list(ds[columns[0]].dims)
-    flat = ds[columns].stack(point=dims) if dims else ds[columns].expand_dims(point=[0])
+    names = [*columns, *extra]
+    flat = ds[names].stack(point=dims) if dims else ds[names].expand_dims(point=[0])
     head = [d.split(".", 1)[-1] for d in dims] + [short.get(c, c) for c in columns]
-    values = {k: flat[k].values for k in [*dims, *columns]}  # (xarray's indexing per cell
-    rows = []                                                 # was most of the table's time)
+    values = {k: flat[k].values for k in [*dims, *names]}  # (xarray's indexing per cell
+    rows = []                                               # was most of the table's time)
     for i in range(flat.sizes["point"]):
         row = [f"{float(values[d][i]):.4g}" for d in dims]
         for c in columns:
             v = float(values[c][i])
-            if c in flags:
+            if c in censored:
+                row.append(_censored(values, c, i))
+            elif c in flags:
                 row.append("yes" if v == 1 else "no")
             elif c in codes:
                 row.append(codes[c].get(int(v), str(v)))
@@ -106,11 +129,12 @@ def summary(ds: xr.Dataset) -> str:
                            "decision_reason), after n members; " if "decision" in ds else "")
             + "stable, unstable, undecided, bounded: fractions of members "
             "(undecided: the run "
-            "cannot tell, see verdict_reason); delta*: stability radius; "
+            "cannot tell, see verdict_reason); delta*: stability radius [its bracket], "
+            "'> x' or '< x' where the sample bounds it from one side only; "
             "n_beta: members with a measured beta; meas/lin: median of measured over the "
             "linear prediction's beta; beta_pred = -ln rho(R)/tau):")  # fmt: skip
     table = grid_table(ds, cols, short, flags=("norm_condition",),
-                       codes={"decision": VERDICT_WORDS})
+                       codes={"decision": VERDICT_WORDS}, censored=("stability_radius",))
     return "\n" + head + "\n" + table + "\n" + unstable_below_one(ds) + undecided_points(ds)
 
 
