@@ -25,7 +25,7 @@ given radii, seed 0), integrated under the Baumgarte law (ω, ξ = 1) to ``t_end
   loop on every thread, one integrator each, and (c)
   ``heyoka.ensemble_propagate_until_batch`` on every thread; at heyoka's recommended
   batch size and, where the CPU has AVX-512 and heyoka recommends 4, also at 8 (as
-  stabdae's kernels, :mod:`stabdae._vector_width`), the driver (c) at the recommended
+  stabdae's kernels, :mod:`stabdae.engine.vector_width`), the driver (c) at the recommended
   size only;
 * ``diffrax.diffeqsolve`` with ``Tsit5`` and a PID controller, ``jax.vmap`` over members
   and ``jax.jit``, on the first ``--diffrax-members`` members and tolerances down to 1e-9
@@ -578,7 +578,7 @@ def main(argv=None):
                 threads=numba.get_num_threads(), stabdae=stabdae.__version__,
                 heyoka=heyoka.__version__, numba=numba.__version__,
                 simd=heyoka.recommended_simd_size(), heyoka_batches=heyoka_batches(),
-                stabdae_512_bit_vectors=stabdae._vector_width.PREFER_512,
+                stabdae_512_bit_vectors=stabdae.engine.vector_width.PREFER_512,
                 argv=sys.argv[1:])  # fmt: skip
     for name in args.scenes:
         rows, compile_s, agreement = run_scene(SCENES[name], args.members, args.repeat,

@@ -47,7 +47,7 @@ from ._codes import (
     VerdictReason,
     flag_attrs,
 )
-from ._vector_width import PREFER_512
+from .engine.vector_width import PREFER_512
 from ._version import __version__
 from .engine.fma import HOST_FMA
 

@@ -101,7 +101,7 @@ def test_vector_width_is_chosen_only_where_numba_leaves_it_open(monkeypatch):
     from numba import config
     from numba.core.codegen import get_host_cpu_features
 
-    from stabdae import _vector_width
+    from stabdae.engine import vector_width as _vector_width
 
     monkeypatch.setattr(config, "CPU_FEATURES", None)
     # this process has compiled: numba's features are fixed, nothing may change them
@@ -110,8 +110,8 @@ def test_vector_width_is_chosen_only_where_numba_leaves_it_open(monkeypatch):
     host = get_host_cpu_features()
     env = dict(os.environ, NUMBA_CPU_FEATURES=host)
     env.pop("STABDAE_VECTOR_WIDTH", None)
-    proc = subprocess.run([sys.executable, "-c", "import numba, stabdae; "
-                           "print(stabdae._vector_width.PREFER_512, numba.config.CPU_FEATURES)"],
+    proc = subprocess.run([sys.executable, "-c", "import numba, stabdae.engine as e; "
+                           "print(e.vector_width.PREFER_512, numba.config.CPU_FEATURES)"],
                           capture_output=True, text=True, env=env, check=True)  # fmt: skip
     assert proc.stdout.split() == ["False", host]
 

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+import stabdae
+
 from conftest import ROOT
 
 SRC = ROOT / "src" / "stabdae"
@@ -56,7 +58,9 @@ def _imports(path: Path) -> set[str]:
 
 
 _MODULES = {_module_name(p) for p in SRC.rglob("*.py")}
-_GRAPH = {_module_name(p): {m for m in _imports(p) if m in _MODULES} for p in SRC.rglob("*.py")}
+# a package's own name is no edge ("from . import vector_width" in its __init__)
+_GRAPH = {_module_name(p): {m for m in _imports(p) if m in _MODULES and m != _module_name(p)}
+          for p in SRC.rglob("*.py")}  # fmt: skip
 
 
 def test_no_import_circle():
@@ -127,6 +131,48 @@ def test_each_module_imports_alone():
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           timeout=600)  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-3000:]
+
+
+def test_command_line_answers_without_the_numerical_stack():
+    """``stabdae --version`` and ``--help`` import neither numba, NumPy, SciPy, xarray nor
+    matplotlib: ``import stabdae`` loads its names on first use, and the command line
+    imports what a command needs inside it."""
+    script = (
+        "import sys\n"
+        "from stabdae.study.cli import main\n"
+        "for argv in (['--version'], ['--help'], ['run', '--help']):\n"
+        "    try:\n"
+        "        main(argv)\n"
+        "    except SystemExit:\n"
+        "        pass\n"
+        "heavy = {'numba', 'numpy', 'scipy', 'xarray', 'matplotlib', 'dask'}\n"
+        "print('LOADED', sorted({m.split('.')[0] for m in sys.modules} & heavy))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=600)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "stabdae " in proc.stdout and "usage: stabdae run" in proc.stdout
+    assert proc.stdout.strip().splitlines()[-1] == "LOADED []", proc.stdout[-500:]
+
+
+def test_public_names_load_on_first_use_after_the_engine_boots():
+    """Every name of ``stabdae.__all__`` resolves (and is the object of its module); in a
+    fresh process, a module imported first (not through ``stabdae.<name>``) still finds
+    the compiled floor booted: the library's ``cache=True`` functions carry the checked
+    cache, whichever module is imported first."""
+    for name in stabdae.__all__:
+        value = getattr(stabdae, name)
+        assert value is not None and name in dir(stabdae), name
+    assert stabdae.ensemble is importlib.import_module("stabdae._ensemble").ensemble
+    with pytest.raises(AttributeError, match="no attribute 'not_a_name'"):
+        stabdae.not_a_name  # noqa: B018
+    for first in ("stabdae.simdmath", "stabdae.theory", "stabdae._model"):
+        script = (f"import {first}, stabdae.simdmath as s\n"
+                  "print(type(s._reduce._cache).__name__)\n")  # fmt: skip
+        proc = subprocess.run([sys.executable, "-c", script], capture_output=True,
+                              text=True, timeout=600)  # fmt: skip
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        assert proc.stdout.split() == ["_CheckedFunctionCache"], (first, proc.stdout)
 
 
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="already without JIT")

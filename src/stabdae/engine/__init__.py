@@ -32,5 +32,14 @@ one floor up do, once).  By role:
   key and checksum checked before it is unpickled (the kernel cache's and the library's own
   ``cache=True`` functions');
 * :mod:`.ahead` — a new model's sampler compiled into that cache by a helper process while
-  this one compiles the ensemble kernel.
+  this one compiles the ensemble kernel;
+* :mod:`.vector_width` — the SIMD width numba compiles for, chosen when this package is
+  first imported.
 """
+
+# vector_width first: numba's CPU features are fixed by the first compiled function; then
+# the checked caches, before any of the library's modules decorates a function
+from . import vector_width  # noqa: F401, I001
+from .checked_cache import checked_library_caches
+
+checked_library_caches()

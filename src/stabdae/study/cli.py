@@ -9,8 +9,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from .._version import __version__
 
 
@@ -66,6 +64,7 @@ def _cmd_check(args) -> int:
 
 
 def _cmd_integrate(args) -> int:
+    import numpy as np
     from scipy.linalg import expm
 
     from .. import baumgarte, integrate, none
@@ -182,6 +181,8 @@ def _cmd_theory(args) -> int:
 def _print_floors(study, base, rec, level: float) -> None:
     """The floors of the minimal-rho gain and of the study's law, and the balanced gain
     for ``level`` (:mod:`stabdae._gains`), at the study's first grid point."""
+    import numpy as np
+
     from .._gains import balanced_gain, gain_floor
     from .._laws import baumgarte
 

@@ -8,14 +8,15 @@ faster per member on such machines (the benchmarks' notes give the figures), and
 results are the same bits: lanes are members, and without fast-math flags LLVM changes
 neither the operations of a lane nor their order.
 
-So, when the host has AVX-512, ``import stabdae`` asks numba for 512-bit vectors by
+So, when the host has AVX-512, the first import of the compiled floor (:mod:`stabdae.engine`,
+imported by the first use of a model, a law or a driver) asks numba for 512-bit vectors by
 adding ``-prefer-256-bit`` to the CPU features numba compiles for.  numba has one set of
 CPU features per process, so the choice also applies to the other functions numba
 compiles in that process (their results are the same bits too; their cached machine code
 is keyed by the features and compiles once more).  It is made only:
 
-* when numba's CPU target is not yet in use (``import stabdae`` before any ``@njit``
-  function was defined: numba fixes its features with the first);
+* when numba's CPU target is not yet in use (no ``@njit`` function compiled before the
+  library's first use: numba fixes its features with the first);
 * when the user set neither ``NUMBA_CPU_NAME`` nor ``NUMBA_CPU_FEATURES`` (their choice
   stands);
 * unless ``STABDAE_VECTOR_WIDTH=256`` (or ``default``) asks to leave numba's choice, for
