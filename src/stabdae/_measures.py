@@ -47,7 +47,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
+from scipy import special  # not scipy.stats: importing it costs more than a study's grid
 
 from ._codes import (
     ProbeStage,
@@ -395,7 +395,7 @@ def median_interval(values, level: float = 0.95) -> tuple[float, float, float, f
 
     ``[v_(r), v_(n+1−r)]`` (1-based order statistics) covers the median of any
     continuous distribution with probability ``1 − 2 P(B ≤ r − 1)``, ``B ~ Bin(n, 1/2)``
-    (:data:`scipy.stats.binom`); ``r`` is the largest rank with coverage at least
+    (:func:`scipy.special.bdtr`); ``r`` is the largest rank with coverage at least
     ``level``.  Where even ``[min, max]`` covers less (``n ≤ 5`` at 95 %), that is the
     interval, with its lower coverage; NaN for no values."""
     v = np.sort(np.asarray(values, dtype=float)[np.isfinite(values)])
@@ -415,10 +415,10 @@ def _median_rank(n: int, level: float) -> tuple[int, float]:
     """The rank ``r`` of :func:`median_interval` for ``n`` values and its coverage (they
     depend on ``n`` and ``level`` only: a study asks for the same few again and again)."""
     r = np.arange(1, n // 2 + 1)
-    cover = 1.0 - 2.0 * stats.binom.cdf(r - 1, n, 0.5)
+    cover = 1.0 - 2.0 * special.bdtr(r - 1, n, 0.5)
     ok = np.flatnonzero(cover >= level)
     k = int(r[ok[-1]]) if ok.size else 1
-    return k, float(1.0 - 2.0 * stats.binom.cdf(k - 1, n, 0.5)) if n > 1 else 0.0
+    return k, float(1.0 - 2.0 * special.bdtr(k - 1, n, 0.5)) if n > 1 else 0.0
 
 
 def stability_radius(alpha_norm, stable, decided) -> tuple[float, float, float, int]:
