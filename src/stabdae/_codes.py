@@ -228,6 +228,10 @@ class DecisionReason(_Codes):
                             "why)")
     WITHIN_TOLERANCE = 4, ("within tolerance: the interval is narrower than the tolerance "
                            "and contains q")
+    NOT_RUN = 5, ("members not run: more than max_not_run of the members could not be "
+                  "placed at their perturbation (or ran out of steps), so what the members "
+                  "that ran decide need not hold for the whole ensemble (their status says "
+                  "why)")
 
 
 class TauStarReason(_Codes):

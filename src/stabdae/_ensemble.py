@@ -28,7 +28,7 @@ import xarray as xr
 
 from . import _measures, theory
 from . import _validate as check
-from ._codes import DecisionReason, Status, messages
+from ._codes import DecisionReason, Status, VerdictReason, messages
 from ._measures import Motion
 from ._ensemble_dataset import Table, _warn_stopped
 from ._ensemble_dataset import ensemble_table as _table
@@ -444,7 +444,9 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
         verdicts = judged[0]
         unstable = int((verdicts == _measures.V_UNSTABLE).sum())
         stable = int((verdicts == _measures.V_STABLE).sum())
-        decision = decide(plan, hi, unstable, hi - stable, last=j == len(looks) - 1)
+        not_run = int((judged[1] == int(VerdictReason.NOT_RUN)).sum())
+        decision = decide(plan, hi - not_run, unstable, hi - not_run - stable,
+                          last=j == len(looks) - 1, not_run=not_run)  # fmt: skip
         if decision.verdict is not None:
             break
         lo = hi
@@ -461,9 +463,12 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
         table.data[name] = schema_entry(name, value, run.model)
     table.attrs.update({f"sequential_{k}": v for k, v in plan.as_dict().items()})
     table.attrs["sequential_looks"] = np.asarray(looks[:j + 1], dtype=np.int64)
+    ran = judged[1] != int(VerdictReason.NOT_RUN)
+    not_run_text = f", {not_run} not run: {_measures.not_run_text(status, ran)}" if not_run else ""
     table.attrs["decision_summary"] = (
         f"{_measures.VERDICTS[decision.verdict]} after {hi} members ({unstable} unstable, "
-        f"{hi - stable - unstable} undecided): the unstable fraction in "
+        f"{hi - not_run - stable - unstable} undecided{not_run_text}): the unstable "
+        f"fraction of the {hi - not_run} that ran in "
         f"[{decision.low:.3g}, {decision.high:.3g}] at confidence {plan.confidence:g}, "
         f"q = {plan.q:g}; {DECISION_REASONS[decision.reason]}")  # fmt: skip
     walls.seconds["dataset"] = time.perf_counter() - clock

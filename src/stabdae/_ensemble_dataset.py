@@ -175,7 +175,7 @@ def ensemble_table(model, p, law, scheme, bound, times, x0, alpha0, norms, trace
     attrs = provenance(model, p, law, scheme, f"ensemble of {x0.shape[0]} members", **run)
     attrs["verdict_summary"] = _measures.verdict_summary(
         verdicts, why, cls != _measures.NOT_RUN,
-        "" if motion is None else motion.describe(epsilon))  # fmt: skip
+        "" if motion is None else motion.describe(epsilon), status)  # fmt: skip
     if referee is not None:
         attrs["reference_floor"] = np.asarray(referee["floor_band"], dtype=float)
     attrs["roundoff_level"] = float(roundoff)

@@ -490,10 +490,18 @@ def ensemble_verdict(n_run: int, n_stable: int, n_unstable: int, q: float = 0.0)
     return V_UNDECIDED
 
 
-def verdict_summary(verdicts, reasons, ran, motion: str = "") -> str:
+def not_run_text(status, ran) -> str:
+    """The members that did not run, counted by their status:
+    ``"12 not placed (sampling failed)"``."""
+    codes, counts = np.unique(np.asarray(status)[~ran], return_counts=True)
+    return ", ".join(f"{c} {Status(int(k)).short}" for k, c in zip(codes, counts))
+
+
+def verdict_summary(verdicts, reasons, ran, motion: str = "", status=None) -> str:
     """One line a user reads first: the counts of each verdict, the undecided and the
     unstable by reason (``motion``: what happened to the unperturbed run where the
-    scheme is unstable on the motion itself, :meth:`Motion.describe`)."""
+    scheme is unstable on the motion itself, :meth:`Motion.describe`), and the members
+    that did not run by their ``status``."""
     n = int(ran.sum())
     parts = []
     for v, name in VERDICTS.items():
@@ -508,4 +516,7 @@ def verdict_summary(verdicts, reasons, ran, motion: str = "") -> str:
                    else "")
                 for r, c in zip(*why)) + ")"  # fmt: skip
         parts.append(text)
-    return f"of {n} members that ran: " + ", ".join(parts)
+    tail = ""
+    if status is not None and n < ran.size:
+        tail = f"; {ran.size - n} of {ran.size} did not run ({not_run_text(status, ran)})"
+    return f"of {n} members that ran: " + ", ".join(parts) + tail

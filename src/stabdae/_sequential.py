@@ -23,6 +23,16 @@ Biometrika 70(3), 1983; here the budget is spent evenly, a Bonferroni split):
   above ``q`` and the share of unstable ones at most ``q``, both at the look's level),
   when the interval is narrower than ``tolerance``, or when ``max`` is reached.
 
+The fractions are of the members that *ran*.  A member that could not be placed at its
+perturbation (the sampler's Gauss–Newton did not reach it) or ran out of adaptive steps
+has no verdict, and counting it as unstable or undecided would let a sampling limit pass
+for a property of the scheme.  Leaving such members out is sound only while they are few:
+the whole ensemble's unstable fraction lies within their share of the ran members' (it
+is ``p (1 − s) + s u`` for a share ``s`` not run, ``u`` of them unstable).  So a decision
+stands only where at most ``max_not_run`` of the members did not run; above that share
+the cell looks again, and it stops *undecided* (reason ``not_run``) once the share's
+own lower bound at the look's level is above ``max_not_run``, or at ``max``.
+
 Members are the same at every look and at every grid point (:func:`.engine.sampler.
 draw_alphas`: member ``i`` is a function of the seed and ``i``), so a cell's numbers do
 not depend on the batches it was run in, only on how many members it ran.
@@ -30,6 +40,7 @@ not depend on the batches it was run in, only on how many members it ran.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from scipy import special
@@ -38,7 +49,7 @@ from ._codes import DecisionReason, Verdict
 
 #: the keys of a sequential ``members`` (in Python a mapping or :class:`Sequential`; in a
 #: study file ``[ensemble] members = { ... }``)
-KEYS = ("confidence", "q", "max", "batch", "tolerance")
+KEYS = ("confidence", "q", "max", "batch", "tolerance", "max_not_run")
 #: the fewest members of a first look (the roundoff level is read on the first 16)
 MIN_BATCH = 16
 
@@ -64,6 +75,9 @@ class Sequential:
     tolerance : float, optional
         Stop, undecided, once the interval is narrower than this (an estimate, not a
         decision, is then what the cell gives).  Default: none.
+    max_not_run : float
+        The largest share of members not run (not placed at their perturbation, or out of
+        adaptive steps) that a decision accepts (see the module's text).  Default 0.01.
     """
 
     confidence: float = 0.95
@@ -71,6 +85,7 @@ class Sequential:
     max: int = 1024
     batch: int = 64
     tolerance: float | None = None
+    max_not_run: float = 0.01
 
     @classmethod
     def of(cls, value, who: str) -> Sequential:
@@ -87,6 +102,10 @@ class Sequential:
             if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0.0 < x < 1.0:
                 raise ValueError(f"{who}: members {key} must be a number between 0 and 1 "
                                  f"(exclusive), got {x!r}")  # fmt: skip
+        x = v["max_not_run"]
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0.0 <= x < 1.0:
+            raise ValueError(f"{who}: members max_not_run must be a number in [0, 1), got "
+                             f"{x!r}")  # fmt: skip
         for key, least in (("max", 1), ("batch", MIN_BATCH)):
             x = v[key]
             if isinstance(x, bool) or not isinstance(x, int) or x < least:
@@ -101,7 +120,7 @@ class Sequential:
             raise ValueError(f"{who}: members tolerance must be a number in (0, 1], got "
                              f"{tol!r}")  # fmt: skip
         return cls(float(v["confidence"]), float(v["q"]), int(v["max"]), int(v["batch"]),
-                   None if tol is None else float(tol))  # fmt: skip
+                   None if tol is None else float(tol), float(v["max_not_run"]))  # fmt: skip
 
     def looks(self) -> list[int]:
         """The members run by each look: ``batch``, doubling, up to ``max``."""
@@ -143,9 +162,28 @@ class Decision:
     high: float
 
 
-def decide(plan: Sequential, n: int, unstable: int, not_stable: int, last: bool) -> Decision:
-    """The decision after ``n`` members, ``unstable`` of them unstable and ``not_stable``
-    unstable or undecided (``last``: no look follows)."""
+def decide(plan: Sequential, n: int, unstable: int, not_stable: int, last: bool,
+           not_run: int = 0) -> Decision:
+    """The decision after ``n`` members that ran, ``unstable`` of them unstable and
+    ``not_stable`` unstable or undecided, beside ``not_run`` members that did not run
+    (``last``: no look follows)."""
+    share = not_run / (n + not_run) if n + not_run else 0.0
+    if n == 0:
+        return Decision(int(Verdict.UNDECIDED), int(DecisionReason.NOT_RUN), math.nan,
+                        math.nan)  # fmt: skip
+    d = _decide_ran(plan, n, unstable, not_stable, last)
+    if share <= plan.max_not_run or d.verdict == int(Verdict.UNDECIDED):
+        return d
+    # too many not run for a decision: look again while more members may bring the share
+    # down, and stop undecided once its own lower bound is above the limit
+    low = bounds(not_run, n + not_run, plan.side_level)[0]
+    final = last or low > plan.max_not_run
+    return Decision(int(Verdict.UNDECIDED) if final else None, int(DecisionReason.NOT_RUN),
+                    d.low, d.high)  # fmt: skip
+
+
+def _decide_ran(plan: Sequential, n: int, unstable: int, not_stable: int,
+                last: bool) -> Decision:
     a = plan.side_level
     (low, unstable_high), (not_stable_low, high) = bounds(unstable, n, a), bounds(not_stable, n, a)
     if high <= plan.q:

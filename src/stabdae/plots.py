@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ._codes import DecisionReason
 from ._schema import open_dataset
 from ._version import __version__
 
@@ -223,6 +224,16 @@ def stability_map(ds: xr.Dataset, path: Path) -> Path:
     return path
 
 
+#: an undecided cell's mark in the decision map, by its ``decision_reason``, and the
+#: legend's words for it (the codes' own text, shortened to what fits a legend)
+_REASON_MARKS = {int(DecisionReason.MAX_REACHED): "m", int(DecisionReason.MEMBERS_UNDECIDED): "u",
+                 int(DecisionReason.WITHIN_TOLERANCE): "t", int(DecisionReason.NOT_RUN): "n"}
+_REASON_WORDS = {int(DecisionReason.MAX_REACHED): "m  max members reached, q inside",
+                 int(DecisionReason.MEMBERS_UNDECIDED): "u  members undecided (verdict_reason)",
+                 int(DecisionReason.WITHIN_TOLERANCE): "t  interval within tolerance",
+                 int(DecisionReason.NOT_RUN): "n  members not run (not placed; status)"}
+
+
 def decision_map(ds: xr.Dataset, path: Path) -> Path:
     """Each grid point's decision (stable, unstable, undecided) and the members it took,
     over the first two swept axes (one axis: a strip), with the outline ``ρ(R(τÃ)) < 1``."""
@@ -240,6 +251,8 @@ def decision_map(ds: xr.Dataset, path: Path) -> Path:
     xe, ye = _edges(x, xlog), _edges(y, ylog)
     dec = sub["decision"].transpose(yd, xd).values
     used = sub["members_used"].transpose(yd, xd).values
+    why = (sub["decision_reason"].transpose(yd, xd).values if "decision_reason" in sub
+           else np.full(dec.shape, -1))  # fmt: skip
     fig, axes = plt.subplots(1, 2, figsize=(11.5, 4.8), constrained_layout=True)
     colors = ListedColormap(["#3b8b3b", "#c0392b", "#bdbdbd"])
     axes[0].pcolormesh(xe, ye, dec, cmap=colors, vmin=-0.5, vmax=2.5, shading="flat")
@@ -253,9 +266,14 @@ def decision_map(ds: xr.Dataset, path: Path) -> Path:
             axes[1].text(cx, cy, str(int(n)), ha="center", va="center", fontsize=6.5,
                          color="white" if n > np.sqrt(used.max() * used.min()) else "black")
             if dec[j, i] == 2:
-                axes[0].text(cx, cy, "?", ha="center", va="center", fontsize=9)
+                axes[0].text(cx, cy, _REASON_MARKS.get(int(why[j, i]), "?"), ha="center",
+                             va="center", fontsize=9)  # fmt: skip
     handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in colors.colors]
-    labels = ["stable (≤ q unstable)", "unstable (> q)", "undecided (?)"]
+    labels = ["stable (≤ q unstable)", "unstable (> q)", "undecided, by its reason:"]
+    for code in sorted({int(c) for c in why[dec == 2]}):  # the marks drawn, decoded
+        handles.append(plt.Line2D([], [], ls="", marker=f"${_REASON_MARKS.get(code, '?')}$",
+                                  color="black", ms=7))  # fmt: skip
+        labels.append(_REASON_WORDS.get(code, f"reason code {code}"))
     hatched = _hatch_motion(axes[0], sub, xd, yd, xe, ye)
     if hatched is not None:
         handles.append(hatched)

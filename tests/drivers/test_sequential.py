@@ -121,7 +121,61 @@ def test_undecided_members_count_against_both_decisions():
     assert d.verdict == UNDECIDED and d.reason == int(DecisionReason.WITHIN_TOLERANCE)
 
 
+def test_members_not_run_are_left_out_of_the_decision_up_to_max_not_run():
+    """The fractions are of the members that ran; a decision stands only where at most
+    ``max_not_run`` did not run: above it the cell looks again, and stops undecided
+    (``not_run``) once that share's lower bound is above the limit, or at the last look."""
+    plan = Sequential()  # max_not_run 0.01
+    level = plan.side_level
+    # 127 ran, all stable, 1 of 128 not placed (0.8 % ≤ 1 %): decided on the 127 alone
+    d = decide(plan, 127, 0, 0, last=False, not_run=1)
+    assert d.verdict == STABLE and d.high == pytest.approx(bounds(0, 127, level)[1])
+    # counted against stability (as one undecided of 128) it would not be decided
+    assert decide(plan, 128, 0, 1, last=False).verdict is None
+    # 3 of 256 not run (1.2 %): the ran members alone are stable, yet the cell looks again,
+    # and at the last look it is undecided for the members not run
+    d = decide(plan, 253, 0, 0, last=False, not_run=3)
+    assert d.verdict is None and d.reason == int(DecisionReason.NOT_RUN)
+    assert bounds(3, 256, level)[0] < plan.max_not_run
+    d = decide(plan, 253, 0, 0, last=True, not_run=3)
+    assert d.verdict == UNDECIDED and d.reason == int(DecisionReason.NOT_RUN)
+    # 8 of 64: the share's lower bound is above 1 %: no look can decide, stop now
+    assert bounds(8, 64, level)[0] > plan.max_not_run
+    d = decide(plan, 56, 0, 0, last=False, not_run=8)
+    assert d.verdict == UNDECIDED and d.reason == int(DecisionReason.NOT_RUN)
+    assert d.low == 0.0 and d.high == pytest.approx(bounds(0, 56, level)[1])
+    # a higher limit accepts them; nothing ran: undecided
+    assert decide(Sequential(max_not_run=0.1), 120, 0, 0, last=False, not_run=8).verdict == STABLE
+    assert decide(plan, 0, 0, 0, last=False, not_run=64).reason == int(DecisionReason.NOT_RUN)
+
+
+def test_a_grid_point_whose_members_cannot_be_placed_says_so():
+    """Pendulum perturbations up to ‖α⁰‖∞ = 2: about a tenth cannot be placed (the
+    sampler's Gauss–Newton does not reach them).  Every member that ran is stable, yet the
+    point is undecided for the members not run, counted by their status in its summary."""
+    model, law = load_scene("pendulum"), stabdae.baumgarte(10.0)
+    with pytest.warns(stabdae.IntegrationWarning, match="not placed"):
+        ds = stabdae.ensemble(model, law, "rk2", 0.01, 3.0, members={"max": 1024},
+                              radius=(0.5, 2.0), seed=1, traces=4)  # fmt: skip
+    unplaced = int((ds.status == int(Status.SAMPLING_FAILED)).sum())
+    n = int(ds.members_used)
+    assert 0 < unplaced and bounds(unplaced, n, Sequential().side_level)[0] > 0.01
+    assert int(ds.members_run) == n - unplaced == int(ds.members_stable)
+    assert int(ds.decision) == UNDECIDED
+    assert int(ds.decision_reason) == int(DecisionReason.NOT_RUN)
+    summary = ds.attrs["decision_summary"]
+    assert f"{unplaced} not run: {unplaced} not placed (sampling failed)" in summary
+    assert f"of the {n - unplaced} that ran" in summary
+    assert ds.attrs["verdict_summary"].endswith(
+        f"{unplaced} of {n} did not run ({unplaced} not placed (sampling failed))")
+    # the same perturbations up to 1: all placed, decided stable
+    ok = stabdae.ensemble(model, law, "rk2", 0.01, 3.0, members={"max": 1024},
+                          radius=(0.1, 1.0), seed=1, traces=4)  # fmt: skip
+    assert int(ok.decision) == STABLE and "not run" not in ok.attrs["decision_summary"]
+
+
 @pytest.mark.parametrize("bad, words", [
+    ({"max_not_run": 1.0}, "max_not_run must be a number in"),
     ({"confidence": 1.0}, "confidence must be a number between 0 and 1"),
     ({"q": 0}, "q must be a number between 0 and 1"),
     ({"batch": 8}, "batch must be an integer of at least 16"),

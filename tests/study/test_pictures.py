@@ -62,3 +62,30 @@ def test_tick_labels_of_a_log_axis_spanning_a_decade_or_two_do_not_overlap(
         assert overlapping_labels(ax.xaxis, renderer) == 0
         labels = [t.get_text() for t in ax.xaxis.get_ticklabels() if t.get_text()]
         assert len(labels) >= 3 and any("3\\times" in t for t in labels), labels
+
+
+def test_the_decision_map_marks_each_undecided_cell_by_its_reason(monkeypatch, tmp_path):
+    """An undecided cell carries the mark of its ``decision_reason``, and the legend
+    decodes every mark drawn (and only those)."""
+    from stabdae._codes import DecisionReason
+
+    tau, omega = np.geomspace(1e-3, 5e-2, 3), np.geomspace(1.0, 1e2, 2)
+    dec = np.array([[0, 2], [2, 1], [2, 2]], dtype=np.int8)
+    why = np.array([[0, int(DecisionReason.NOT_RUN)], [int(DecisionReason.MAX_REACHED), 1],
+                    [int(DecisionReason.NOT_RUN), int(DecisionReason.MEMBERS_UNDECIDED)]],
+                   dtype=np.int8)  # fmt: skip
+    ds = xr.Dataset(
+        {"fraction_stable": (("tau", "omega"), np.full(dec.shape, 0.5)),
+         "fraction_bounded": (("tau", "omega"), np.full(dec.shape, 0.5)),
+         "decision": (("tau", "omega"), dec), "decision_reason": (("tau", "omega"), why),
+         "members_used": (("tau", "omega"), np.full(dec.shape, 64))},
+        coords={"tau": ("tau", tau, {"units": "s"}), "omega": ("omega", omega, {"units": "s-1"})},
+        attrs={"model": "test", "law": "baumgarte", "scheme": "rk4"},
+    )  # fmt: skip
+    fig = drawn_figure(monkeypatch, plots.decision_map, ds, tmp_path / "p.png")
+    marks = sorted(t.get_text() for t in fig.axes[0].texts)
+    assert marks == ["m", "n", "n", "u"]
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    reasons = [t for t in legend if t[:3] in ("m  ", "n  ", "u  ", "t  ")]
+    assert [t[0] for t in reasons] == ["m", "u", "n"], legend  # in the codes' order
+    assert any("not run" in t for t in reasons) and not any(t.startswith("t ") for t in legend)
