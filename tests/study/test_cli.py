@@ -169,6 +169,26 @@ def test_progress_says_compiling_until_the_kernels_are_ready(tmp_path, capsys):
     assert " 0/48 " in compiling and "?" in compiling  # no rate, no time left guessed
 
 
+def test_progress_counts_the_members_that_ran(tmp_path, capsys):
+    """Grid points run until decided: the bar counts the members that ran (not each
+    point's max), and ends at its total, the sum of the points' members_used."""
+    import re
+
+    from conftest import study_file
+
+    study = study_file(tmp_path, members="{ max = 256, batch = 16 }", t_end=0.2,
+                       omegas="5.0")  # fmt: skip
+    assert main(["run", str(study), "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    counts = re.findall(r"\| (\d+)/(\d+) \[", err.replace("\r", "\n"))
+    ds = xr.open_dataset(tmp_path / "out" / "study.nc")
+    used = int(ds.members_used.sum())
+    ds.close()
+    assert used < 6 * 256  # decided before max: the old bar counted 6 × 256
+    assert counts and counts[-1] == (str(used), str(used)), counts[-3:]
+    assert all(int(n) <= used for n, _ in counts)
+
+
 def test_plot_refuses_an_older_dataset_in_one_line(tmp_path, capsys):
     """A dataset written by an earlier version, without a variable this version's pictures
     read: one line that names both versions and what is missing, exit 2, no traceback;

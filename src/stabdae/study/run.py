@@ -303,7 +303,7 @@ def _run_locked(study, out, parts, manifest, workers, scheduler, progress, threa
         for key in _VOLATILE:
             table.attrs.pop(key, None)
         store.add(i, table)
-        bar.point_done()
+        bar.point_done(_members_used(table))
 
     finished = False
     try:
@@ -503,6 +503,15 @@ def _combine_searches(study: Study, pts: list[xr.Dataset], dims: list[str]) -> x
     return ds.transpose(*dims, ...)
 
 
+def _members_used(table: Table) -> int | None:
+    """The members a grid point ran (None where the table does not say: a search)."""
+    entry = table.data.get("members_used")
+    if entry is not None:
+        return int(np.asarray(entry[1]))
+    entry = table.data.get("status")
+    return None if entry is None or "member" not in entry[0] else int(np.shape(entry[1])[0])
+
+
 def _work_per_point(study: Study) -> int:
     """A grid point's work in member runs: its ensemble's members, or for a boundary
     search the members of the probes it is expected to run (the bracket's ends, two
@@ -519,30 +528,45 @@ def _work_per_point(study: Study) -> int:
 
 
 class _Progress:
-    """A progress bar over grid points and their work in member runs
-    (:func:`_work_per_point`; tqdm when installed, else a line on stderr per point);
-    silent when ``enabled`` is false."""
+    """A progress bar over the members run (tqdm when installed, else a line on stderr per
+    point); silent when ``enabled`` is false.
+
+    The bar counts the members that ran, and its total is the members run so far plus, for
+    each grid point still to run, the mean members of the points done in this run (before
+    the first: ``members``, the most a point may run, :func:`_work_per_point`); a point
+    run until decided usually stops well before its ``max``, so the total shrinks as the
+    points show how many they need.  Its rate (and the time left) is measured from the
+    first members done: before them it reads "compiling", with no rate."""
 
     def __init__(self, points: int, done: int, members: int, enabled: bool):
         self.points, self.done, self.members_total = points, done, members
         self.enabled = enabled and points > 0
         self._bar = None
+        self._run = 0  # members run by the points done in this run
+        self._finished = 0  # points done in this run
         if self.enabled:
             try:
                 from tqdm import tqdm
 
                 # the first chunk waits for the kernels to compile (or load from the cache)
-                self._bar = tqdm(total=points * members, initial=done * members,
-                                 unit="member", desc="stabdae run (compiling)",
-                                 file=sys.stderr, dynamic_ncols=True)  # fmt: skip
+                self._bar = tqdm(total=(points - done) * members, unit="member",
+                                 desc="stabdae run (compiling)", file=sys.stderr,
+                                 dynamic_ncols=True)  # fmt: skip
             except ImportError:
                 self._bar = None
                 print("stabdae run: compiling the kernels (first use only) …", file=sys.stderr)
-        self._last = 0
+        self._last = 0  # members run so far by the point running now
         self._started = time.perf_counter()
         self._compiling = True
 
+    def _show(self, n: int, total: int | None = None):
+        if self._bar is not None:
+            if total is not None:
+                self._bar.total = max(total, n)
+            self._bar.update(n - self._bar.n)
+
     def members(self, done: int, total: int):
+        """``done`` members of the point running now have run."""
         if self._compiling:
             self._compiling = False
             if self._bar is not None:
@@ -550,37 +574,38 @@ class _Progress:
                 self._bar.set_description(f"stabdae run (kernels ready in {seconds:.0f} s)")
                 # the rate and time left from here on: the clock restarts, and what is
                 # done so far (the first chunk, which waited for the compiler) is its start
-                start = self._bar.n + done - self._last
                 self._bar.reset(total=self._bar.total)
-                self._bar.n = self._bar.last_print_n = self._bar.initial = start
+                self._bar.n = self._bar.last_print_n = self._bar.initial = self._run + done
                 self._bar.refresh()
                 self._last = done
                 return
-        if self._bar is not None:
-            self._bar.update(done - self._last)
-            self._last = done
+        self._last = max(self._last, done)
+        self._show(self._run + self._last)
 
     def note(self, text: str):
-        """A line from a boundary search (each probe): its members count on the bar, up
-        to the point's share less one (the rest when the point is done)."""
+        """A line from a boundary search (each probe): its members count on the bar."""
         if self._compiling:
             self.members(0, self.members_total)
         run = re.search(r" of (\d+) members", text)
         if run is not None:
-            self.members(min(self._last + int(run.group(1)), self.members_total - 1), 0)
+            self.members(self._last + int(run.group(1)), 0)
         if self._bar is not None:
             self._bar.set_postfix_str(text.removeprefix("boundary: "), refresh=False)
         elif self.enabled:
             print(f"stabdae run: {text}", file=sys.stderr)
 
-    def point_done(self):
+    def point_done(self, used: int | None = None):
+        """A grid point is done, after ``used`` members (None: those reported)."""
         self.done += 1
+        self._finished += 1
+        self._run += self._last if used is None else int(used)
+        self._last = 0
+        left = self.points - self.done
+        self._show(self._run, self._run + round(left * self._run / self._finished))
         if self._bar is not None:
-            self._bar.update(self.members_total - self._last)
             self._bar.set_postfix_str(f"grid point {self.done}/{self.points}")
         elif self.enabled:
             print(f"stabdae run: grid point {self.done}/{self.points} done", file=sys.stderr)
-        self._last = 0
 
     def close(self):
         if self._bar is not None:
