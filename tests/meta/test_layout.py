@@ -15,7 +15,6 @@ from pathlib import Path
 import pytest
 
 import stabdae
-
 from conftest import ROOT
 
 SRC = ROOT / "src" / "stabdae"
