@@ -567,19 +567,23 @@ def test_every_setting_that_decides_the_numbers_is_in_the_run_key(tmp_path, monk
 
 
 def test_progress_counts_every_member_of_every_point(capsys):
-    """The bar's total is points × members, a resumed run starts at the points done, each
-    point's members advance it to its end, and the last point reads ``3/3``; disabled, or
-    with no point to run, nothing is written."""
+    """The bar counts the members this run runs: before any point, the points left × the
+    most members a point may run (a resumed run leaves out the points done); each point's
+    members advance it, and a point done after fewer shrinks the total to what the points
+    done need on average; the last point reads ``3/3``; disabled, or with no point to
+    run, nothing is written."""
     from stabdae.study.run import _Progress
 
-    bar = _Progress(3, 1, 10, True)  # 3 points, 1 done before, 10 members each
-    assert (bar._bar.total, bar._bar.n) == (30, 10)
-    for _ in range(2):
-        bar.members(4, 10)
-        assert bar._bar.n in (14, 24)
-        bar.members(10, 10)
-        bar.point_done()
-    assert bar._bar.n == 30
+    bar = _Progress(3, 1, 10, True)  # 3 points, 1 done before, at most 10 members each
+    assert (bar._bar.total, bar._bar.n) == (20, 0)
+    bar.members(4, 10)
+    assert bar._bar.n == 4
+    bar.point_done(6)  # decided after 6 members: the other point is expected to need 6
+    assert (bar._bar.total, bar._bar.n) == (12, 6)
+    bar.members(10, 10)
+    assert bar._bar.n == 16
+    bar.point_done()  # the members reported: 10
+    assert bar._bar.n == bar._bar.total == 16
     bar.close()
     assert "grid point 3/3" in capsys.readouterr().err
     for quiet in (_Progress(3, 0, 10, False), _Progress(0, 0, 10, True)):
