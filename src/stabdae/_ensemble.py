@@ -444,7 +444,8 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
         verdicts = judged[0]
         unstable = int((verdicts == _measures.V_UNSTABLE).sum())
         stable = int((verdicts == _measures.V_STABLE).sum())
-        not_run = int((judged[1] == int(VerdictReason.NOT_RUN)).sum())
+        ran = judged[1] != int(VerdictReason.NOT_RUN)
+        not_run = int(hi - ran.sum())
         decision = decide(plan, hi - not_run, unstable, hi - not_run - stable,
                           last=j == len(looks) - 1, not_run=not_run)  # fmt: skip
         if decision.verdict is not None:
@@ -463,7 +464,6 @@ def _sequential_table(run: _RunSpec, plan: Sequential, peak, gain, times) -> Tab
         table.data[name] = schema_entry(name, value, run.model)
     table.attrs.update({f"sequential_{k}": v for k, v in plan.as_dict().items()})
     table.attrs["sequential_looks"] = np.asarray(looks[:j + 1], dtype=np.int64)
-    ran = judged[1] != int(VerdictReason.NOT_RUN)
     not_run_text = f", {not_run} not run: {_measures.not_run_text(status, ran)}" if not_run else ""
     table.attrs["decision_summary"] = (
         f"{_measures.VERDICTS[decision.verdict]} after {hi} members ({unstable} unstable, "

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -67,11 +66,11 @@ class Table:
 def _warn_stopped(name: str, status) -> None:
     """One warning for the members that stopped, counted by reason (as :func:`integrate`
     warns for one trajectory)."""
-    stopped = Counter(int(s) for s in status[status != 0])
-    if not stopped:
+    status = np.asarray(status)
+    total = int((status != 0).sum())
+    if not total:
         return
-    reasons = ", ".join(f"{n} {Status(s).short}" for s, n in sorted(stopped.items()))
-    total = sum(stopped.values())
+    reasons = _measures.not_run_text(status, status == 0)
     warnings.warn(
         f"ensemble({name}): {total} of {status.shape[0]} members stopped: {reasons}; "
         "their samples up to the stop are kept (see the status variable)",
