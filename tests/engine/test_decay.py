@@ -387,16 +387,48 @@ def test_log_prefactor_fit_outside_the_normal_range_is_least_squares():
 
 def test_no_transient_or_growth_gives_no_rate_and_says_why():
     """A trace that sits on its floor, and one that grows, get β = NaN with their
-    reasons, never a fitted number."""
+    reasons, never a fitted number.  A trace that falls below its start and then rises
+    with its own floor over the last three fifths (a member's deviation that the scheme
+    couples to the motion) decayed, as its verdict says: no transient, never "not
+    decaying"."""
     from stabdae.engine import decay
 
     t = np.arange(2001) * 1e-3
     flat = 1e-6 * (1.0 + 0.5 * np.random.default_rng(3).random(t.size))
     growing = 1e-6 * np.exp(3.0 * t)
-    meas = decay.measure_traces(np.stack([flat, growing]), t)
+    rising_floor = np.maximum(np.exp(-10.0 * t), 0.02 + 0.2 * t)
+    meas = decay.measure_traces(np.stack([flat, growing, rising_floor]), t)
     assert np.isnan(meas["beta"]).all()
     assert meas["reason"][0] == decay.R_NO_TRANSIENT
     assert meas["reason"][1] == decay.R_NOT_DECAYING
+    assert decay.grows(*(rising_floor[(400 * w):(400 * w + 401)].max() for w in (2, 3, 4)))
+    assert meas["reason"][2] == decay.R_NO_TRANSIENT
+
+
+def test_a_prediction_is_stepped_from_its_own_members_alpha():
+    """:func:`decay.predict` for a member fitted by its envelope steps ``g_{k+1} = R g_k``
+    from its own row of the perturbations: two members along the two eigenvectors of an
+    ``R`` with rates 10 and 40 get those rates (a prediction from another row would give
+    the other's)."""
+    from stabdae.engine.decay import record as rec
+
+    h, nsteps = 1e-3, 400
+    V = np.array([[1.0, 1.0], [-10.0, -40.0]])  # eigenvectors (f, ḟ) of the modes
+    R = V @ np.diag(np.exp(-h * np.array([10.0, 40.0]))) @ np.linalg.inv(V)
+    alphas = (1e-3 * V.T).copy()  # row i along mode i
+    lt, lv, base = decay.ladders(2)
+    meas = np.full((2, decay.NCOLS), np.nan)
+    codes = np.zeros((2, decay.NCODES), np.int64)
+    rt, ry, a, b, lg = decay.scratch()
+    got = []
+    for row in (1, 0):
+        codes[row, rec.I_REASON] = decay.R_FITTED
+        codes[row, rec.I_KIND] = decay.K_EXPONENTIAL
+        meas[row, rec.C_FIT_START], meas[row, rec.C_FIT_END] = 0.02, 0.3
+        decay.predict(R, alphas, row, nsteps, h, lt, lv, base, meas, codes, row, row, rt, ry,
+                      a, b, lg, np.empty(2), np.empty(2), 0.0)  # fmt: skip
+        got.append(meas[row, rec.C_BETA_PRED])
+    np.testing.assert_allclose(got, [40.0, 10.0], rtol=1e-6)
 
 
 def test_fitted_map_is_read_in_the_groups_of_the_law_spectrum():
@@ -446,18 +478,18 @@ def test_a_floor_rising_with_the_motion_is_no_growth():
     """The double pendulum under Euler (τ = 1e-4, 5 s): each member's deviation from the
     reference trajectory decays by two decades or more, then rises again as its chaotic
     motion drifts from the reference's, and its floor with it.  That late rise is no
-    growth that keeps the member from its one-step map: two thirds of the members 10×
-    above their floor get a β (a fifth did when the rise was read as growth), and every
-    β given is the law's rate −ln ρ(R)/τ to 1 %."""
+    growth that keeps the member from its one-step map, whose window may reach down to
+    ``GENERATOR_MARGIN`` times the floor (the forcing there enters the least-squares fit
+    weighted by ``‖g_k‖²``): every member 10× above its floor gets a β, the law's rate
+    −ln ρ(R)/τ to 1 % (about 60 % did with the window ending 30× above the floor, and the
+    rest were said not to decay although their verdicts said they decayed)."""
     model = load_scene("double_pendulum")
     ds = stabdae.ensemble(model, stabdae.baumgarte(10.0, 1.0), "euler", 1e-4, 5.0,
                           members=128, radius=(1e-3, 1e-1), seed=1)  # fmt: skip
     above = ds.alpha0_norm.values >= 10.0 * ds.residual_floor.values
     ratio = ds.beta_ratio.values[above]
     assert above.sum() >= 40 and (ds.verdict.values[above] == Verdict.STABLE).all()
-    assert np.isfinite(ratio).mean() >= 0.6, np.isfinite(ratio).mean()
-    given = ratio[np.isfinite(ratio)]
-    np.testing.assert_allclose(given, 1.0, atol=0.01)
+    np.testing.assert_allclose(ratio, 1.0, atol=0.01)
 
 
 def _generator_rate(A, G, steps, pm, h_ref=0.01):

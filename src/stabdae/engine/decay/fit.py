@@ -356,8 +356,7 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code, noise=0.
     start, end = _window(rt, ry, n, floor, still_decaying, noise)
     if end == 0:
         # no decade of decay above the floor: growing, or started near its floor
-        code[I_REASON] = (R_NOT_DECAYING if grows(out[C_D2], out[C_D3], out[C_D4])
-                         else R_NO_TRANSIENT)  # fmt: skip
+        code[I_REASON] = _without_rate(out)
         return
     beta, sse = _fit_linear(rt, ry, start, end)
     kind = K_EXPONENTIAL
@@ -376,12 +375,25 @@ def estimate(rt, ry, n, floor, still_decaying, dt, a, b, lg, out, code, noise=0.
     code[I_KIND] = kind
     out[C_SHIFT] = shift
     if not (beta > 0.0):
-        code[I_REASON] = R_NOT_DECAYING
+        code[I_REASON] = _without_rate(out)
         return
     out[C_BETA] = beta
     # (the start is a point of the transient whose level a later visit may hold)
     out[C_GAMMA] = max(gamma_of(rt, ry, end, beta, noise), out[C_INITIAL])
     code[I_REASON] = R_FITTED
+
+
+@njit(cache=True, _nrt=False)
+def _without_rate(out):
+    """Why a member's row ``out`` has no rate where its envelope gave none: not decaying
+    where its deviation grew over the last three fifths (:func:`grows`) to end at or above
+    its start; else no transient.  A deviation that ended below its start decayed (the
+    verdicts' ``decayed``), also where it rose again late with its own floor (the
+    scheme's coupling of the perturbation to the motion): its decay is what lay too
+    close to that floor to be read."""
+    if grows(out[C_D2], out[C_D3], out[C_D4]) and not (out[C_D4] < out[C_INITIAL]):
+        return R_NOT_DECAYING
+    return R_NO_TRANSIENT
 
 
 @njit(cache=True, _nrt=False)

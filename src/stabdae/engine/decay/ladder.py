@@ -21,7 +21,8 @@ _SHIFT = 52 - 3
 #: levels of the ladder, and how many lie above the member's initial norm
 NBINS = 512
 ABOVE = 80
-_START_BIN = NBINS - 1 - ABOVE
+#: the level of every member's initial norm (:func:`ladder_base`)
+START_LEVEL = NBINS - 1 - ABOVE
 
 
 # --------------------------------------------------------------------- the ladder
@@ -125,7 +126,7 @@ def ladder_base(g0):
     """The ladder's offset for a member whose initial norm is ``g0``: its level is
     ``NBINS − 1 − ABOVE``.  (A zero or non-finite ``g0`` anchors the ladder at 1.)"""
     ref = g0 if (g0 > 0.0 and g0 < math.inf) else 1.0
-    return (float_bits(ref) >> _SHIFT) - _START_BIN
+    return (float_bits(ref) >> _SHIFT) - START_LEVEL
 
 
 @njit(cache=True, forceinline=True)
@@ -157,10 +158,10 @@ def ladder_top(lt, j):
     ``ABOVE`` levels one by one for every member that never rose above its start)."""
     row = lt[j]
     top = -1
-    for b in range(_START_BIN, NBINS):
+    for b in range(START_LEVEL, NBINS):
         top = max(top, b if row[b] >= 0.0 else -1)
     if top < 0:
-        for b in range(_START_BIN - 1, -1, -1):
+        for b in range(START_LEVEL - 1, -1, -1):
             if row[b] >= 0.0:
                 return b
     return top

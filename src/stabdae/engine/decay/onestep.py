@@ -18,6 +18,7 @@ from .ladder import (
     LEVELS_PER_OCTAVE,
     LOG2_BOUND,
     NBINS,
+    START_LEVEL,
     float_bits,
     float_from_bits,
     ladder_level,
@@ -58,7 +59,8 @@ CLUSTER = 0.02
 #: of squares are left out of the fit (no transient moves there: what is seen there is
 #: the floor's motion)
 MAP_RANK_TOL = 1e-12
-#: the pairs used lie above this many times the floor (then ``FLOOR_MARGIN``)
+#: the pairs used lie above this many times the floor (then ``FLOOR_MARGIN``, then
+#: ``GENERATOR_MARGIN``)
 MAP_MARGIN = 100.0
 #: all pairs are used when the largest norm fell from each of the last three fifths to
 #: the next, by this factor from the third to the fifth: the run ended inside the
@@ -768,8 +770,10 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
     still decaying (``MAP_STILL_DECAYING``), else those from its start until its level
-    first fell below ``MAP_MARGIN`` (then ``FLOOR_MARGIN``) times its floor (rounded up
-    to a bin of :func:`map_buffers`), give ``R̂`` by least squares; ``β = −ln ρ(R̂)/τ``.
+    first fell below ``MAP_MARGIN`` (then ``FLOOR_MARGIN``, then ``GENERATOR_MARGIN``)
+    times its floor (rounded up to a bin of :func:`map_buffers`; for a member that rose
+    above its start, at most to the start's bin, which holds the rise), give ``R̂`` by
+    least squares; ``β = −ln ρ(R̂)/τ``.
     ``ref``: the law's spectrum (:func:`reference_logs`; NaN: none), in whose groups the
     fitted map's eigenvalues are read (:func:`_grouped`).
     For a residual that follows ``g_{k+1} = R g_k`` this is ``−ln ρ(R)/τ`` exactly,
@@ -794,8 +798,6 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
              and meas[row, C_D2] >= MAP_STILL_DECAYING * meas[row, C_D4])  # fmt: skip
     per_decade = LEVELS_PER_OCTAVE * math.log2(10.0) * MIN_DECADES
     for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, GENERATOR_MARGIN):
-        if margin == GENERATOR_MARGIN and not gen_h > 0.0:
-            break
         if margin < 0.0:  # still decaying: the last fifth's largest norm is no floor
             if not still:
                 continue
@@ -807,7 +809,11 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
         if top - cut < per_decade:
             continue
         first = (cut + (1 << MAP_SHIFT) - 1) >> MAP_SHIFT  # bins wholly above the cut
-        read = max(first, low_bin)  # (the bins below low_bin hold its sums)
+        # (the bins below low_bin hold its sums; those above the start's hold none, the
+        # start being the first fall below them, so that the pairs of a member that rose
+        # above its start and fell back are read from the start's bin, which ends at most
+        # a bin below the cut)
+        read = min(max(first, low_bin), START_LEVEL >> MAP_SHIFT)
         if gen_h > 0.0:
             rho, pairs = _generator_radius(S, j, ng, pm, read, ref, gen_h)
             # too few steps above this cut: a lower one has more
@@ -861,10 +867,12 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
 #: trapezoidal fit's ``(hβ)²/12`` by about another ``(hβ)²/12``; the third is past
 #: roundoff for ``hβ < 0.5``)
 GENERATOR_SWEEPS = 3
-#: the generator's window may reach down to this many times its floor (after
-#: ``MAP_MARGIN`` and ``FLOOR_MARGIN``): what is left there is the noise of a member's
-#: steps falling apart from the reference's, which the least-squares fit averages, not a
-#: bias
+#: the one-step map's and the generator's window may reach down to this many times the
+#: floor (after ``MAP_MARGIN`` and ``FLOOR_MARGIN``): what is left there is the forcing
+#: of the member's distance from the reference by the motion (the scheme's local errors
+#: along two trajectories; on adaptive steps, also steps that fall apart from the
+#: reference's), which enters the least-squares fit weighted by ``‖g_k‖²``: the
+#: transient's top sets the fit, and the forcing moves the rate by about ``floor / top``
 GENERATOR_MARGIN = 10.0
 
 
