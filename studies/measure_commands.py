@@ -56,8 +56,9 @@ def timed(cmd, env=None) -> dict:
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    if proc.returncode != 0:
-        raise SystemExit(f"{' '.join(cmd)} failed ({proc.returncode}):\n{proc.stderr[-3000:]}")
+    if proc.returncode != 0:  # (pytest reports its failures on stdout)
+        raise SystemExit(f"{' '.join(cmd)} failed ({proc.returncode}):\n"
+                         f"{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
     text = proc.stdout + proc.stderr
     out = {"wall_s": round(wall, 2), "cpu_s": round(cpu, 2), "load": round(load, 2),
            "tail": text.strip().splitlines()[-3:]}

@@ -923,8 +923,8 @@ MUTANTS = [
     # ---- the members' ends: the highest level found once, no reference counts
     Mutant("ladder-top-skips-below-start",
            E + "decay/ladder.py",
-           "    if top < 0:\n        for b in range(_START_BIN - 1, -1, -1):\n",
-           "    if top < -1:\n        for b in range(_START_BIN - 1, -1, -1):\n",
+           "    if top < 0:\n        for b in range(START_LEVEL - 1, -1, -1):\n",
+           "    if top < -1:\n        for b in range(START_LEVEL - 1, -1, -1):\n",
            ('tests/engine/test_decay.py::test_ladder_top_is_the_highest_level_visited',),
            "a member that never reached its initial level's ladder has no highest level"),
     Mutant("records-from-below-top",
