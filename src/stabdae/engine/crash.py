@@ -15,14 +15,19 @@ after the guard, saying that a kernel ran earlier rather than that one crashed.
 
 The handler calls only ``write``, ``strlen`` and ``sigaction`` (async-signal-safe); it is a
 few lines of LLVM IR compiled by llvmlite once per process under the first guard, with the
-addresses it writes from (this process's) as constants.  Linux only; elsewhere, or with
-``STABDAE_CRASH_MESSAGE=off``, nothing is installed.
+addresses it writes from (this process's) as constants.  What it reads lies in pages of
+their own, outside the C library's heap, the message's read-only between guards: a model
+that writes past an array on the heap corrupts that array's neighbours there, and a
+message held among them came out as the bytes the model wrote, or not at all, when the C
+library then aborted.  Linux only; elsewhere, or with ``STABDAE_CRASH_MESSAGE=off``,
+nothing is installed.
 """
 
 from __future__ import annotations
 
 import contextlib
 import ctypes
+import mmap
 import os
 import signal
 import sys
@@ -43,9 +48,15 @@ _LOCK = threading.Lock()
 #: ``lingering``: the handler stays installed after the outermost guard, with the message
 #: of :func:`_after_message` (corrupted memory is often found later, at a free)
 _state = {"depth": 0, "handler": None, "failed": False, "lingering": False}
-_MESSAGE = ctypes.create_string_buffer(4096)
-_OLD = {sig: (ctypes.c_char * _ACTION_BYTES)() for sig in _SIGNALS}
-_NEW = (ctypes.c_char * _ACTION_BYTES)()
+_PAGE = mmap.PAGESIZE
+#: the message, and the actions saved and installed, each in an anonymous mapping of its
+#: own (``mmap``: not on the C library's heap, where a model's stray writes land)
+_TEXT = mmap.mmap(-1, _PAGE)
+_ACTIONS = mmap.mmap(-1, _PAGE)
+_MESSAGE = (ctypes.c_char * _PAGE).from_buffer(_TEXT)
+_OLD = {sig: (ctypes.c_char * _ACTION_BYTES).from_buffer(_ACTIONS, i * _ACTION_BYTES)
+        for i, sig in enumerate(_SIGNALS)}  # fmt: skip
+_NEW = (ctypes.c_char * _ACTION_BYTES).from_buffer(_ACTIONS, len(_SIGNALS) * _ACTION_BYTES)
 
 
 def _message(who: str) -> bytes:
@@ -90,7 +101,17 @@ def _libc_functions():
     size_t = ctypes.c_size_t
     return {"write": fn("write", ctypes.c_ssize_t, ctypes.c_int, size_t, size_t),
             "strlen": fn("strlen", size_t, size_t),
-            "sigaction": fn("sigaction", ctypes.c_int, ctypes.c_int, size_t, size_t)}
+            "sigaction": fn("sigaction", ctypes.c_int, ctypes.c_int, size_t, size_t),
+            "mprotect": fn("mprotect", ctypes.c_int, size_t, size_t, ctypes.c_int)}
+
+
+def _set_message(text: bytes, libc) -> None:
+    """The handler's message, in its page, which is read-only again after the write (a
+    stray write there faults, and the handler still has its message)."""
+    at = ctypes.addressof(_MESSAGE)
+    libc["mprotect"](at, _PAGE, mmap.PROT_READ | mmap.PROT_WRITE)
+    _MESSAGE.value = text
+    libc["mprotect"](at, _PAGE, mmap.PROT_READ)
 
 
 class _Handler:
@@ -142,15 +163,16 @@ def _compile_handler():
     machine = llvm.Target.from_default_triple().create_target_machine()
     engine = llvm.create_mcjit_compiler(parsed, machine)
     engine.finalize_object()
-    return _Handler(engine, engine.get_function_address("stabdae_crash")), libc["sigaction"]
+    return _Handler(engine, engine.get_function_address("stabdae_crash")), libc
 
 
 def _install(who: str) -> None:
     if _state["handler"] is None:
         _state["handler"] = _compile_handler()
-    handler, c_sigaction = _state["handler"]
-    _MESSAGE.value = _message(who)
-    if _state["lingering"] and _still_ours(handler, c_sigaction):
+    handler, libc = _state["handler"]
+    c_sigaction = libc["sigaction"]
+    _set_message(_message(who), libc)
+    if _state["lingering"] and _still_ours(handler, libc):
         return  # installed since an earlier guard: the actions saved then stay the ones before
     ctypes.memset(_NEW, 0, _ACTION_BYTES)
     ctypes.memmove(_NEW, ctypes.byref(ctypes.c_size_t(handler.address)), 8)
@@ -161,11 +183,11 @@ def _install(who: str) -> None:
             raise OSError(f"sigaction({int(sig)}) failed")
 
 
-def _still_ours(handler, c_sigaction) -> bool:
+def _still_ours(handler, libc) -> bool:
     """Whether every signal's action is still this handler (nobody replaced it since)."""
     now = (ctypes.c_char * _ACTION_BYTES)()
     for sig in _SIGNALS:
-        if c_sigaction(int(sig), 0, ctypes.addressof(now)) != 0:
+        if libc["sigaction"](int(sig), 0, ctypes.addressof(now)) != 0:
             return False
         if ctypes.c_size_t.from_buffer(now).value != handler.address:
             return False
@@ -175,13 +197,13 @@ def _still_ours(handler, c_sigaction) -> bool:
 def _linger(who: str) -> None:
     """After the outermost guard: the handler stays, saying that a kernel ran earlier
     (heap corruption is often detected only at a later free, outside any kernel)."""
-    _MESSAGE.value = _after_message(who)
+    _set_message(_after_message(who), _state["handler"][1])
     _state["lingering"] = True
 
 
 def _restore() -> None:
     """Put back the actions from before the first guard (for tests)."""
-    _, c_sigaction = _state["handler"]
+    c_sigaction = _state["handler"][1]["sigaction"]
     for sig in _SIGNALS:
         c_sigaction(int(sig), ctypes.addressof(_OLD[sig]), 0)
     _state["lingering"] = False
