@@ -451,10 +451,9 @@ def test_a_member_whose_deviation_ended_below_its_start_is_never_not_decaying():
     to three decades, then follows a floor of its own (the scheme's coupling of its
     perturbation to the motion) that rises over the run.  A member whose decay lies too
     close to that floor is withheld as "no transient", as its verdict (decayed) agrees;
-    never "not decaying" (13 of 71 members 10× above their floor were).  Every β given is
+    never "not decaying" (14 of 71 members 10× above their floor were).  Every β given is
     the law's rate to 1 %, and more than half of those members get one."""
     from models.four_bar import model as four_bar
-
     from stabdae._codes import BetaReason
 
     ds = stabdae.ensemble(four_bar, stabdae.baumgarte(10.0, 2.0), "midpoint", 1e-3, 5.0,
@@ -502,10 +501,12 @@ def test_a_law_whose_step_is_a_multiple_of_the_identity():
 def test_a_members_measures_do_not_depend_on_its_place_in_the_ensemble(tau):
     """Each member's measures, its linear prediction included, are its own: the same
     members given in reverse order get the same values, member by member.  Among them
-    members fitted by their one-step map, with their predictions; members whose residual rises from far below its floor beside members whose residual
-    falls (a level one of them left in a slot of the block would be read as the next
-    one's); and, at the longer step, members whose norm falls past several levels of
-    their ladder at a step."""
+    members fitted by their one-step map, with their predictions; members whose residual
+    rises from far below its floor beside members whose residual falls (a level one of
+    them left in a slot of the block would be read as the next one's); and, at the
+    longer step, members whose norm falls past several levels of their ladder at a
+    step.  (A prediction stepped from a member's own row of ``α⁰``, for a member fitted
+    by its envelope: ``tests/engine/test_decay.py``.)"""
     model = load_scene("pendulum")
     law = stabdae.baumgarte(10.0, 1.0)
     x0 = stabdae.sample_perturbations(model, 400, (1e-6, 1e-2), seed=1)[0]

@@ -640,7 +640,8 @@ MUTANTS = [
            "    if grows(out[C_D2], out[C_D3], out[C_D4]):\n",
            ('tests/engine/test_decay.py::test_no_transient_or_growth_gives_no_rate_and_says_why',
             'tests/drivers/test_measurement.py::test_a_member_whose_deviation_ended_below_its_start_is_never_not_decaying'),
-           "a member whose deviation ended below its start, then rose with its floor, is said not to decay"),
+           "a member whose deviation ended below its start, then rose with its floor, is said "
+           "not to decay"),
     Mutant("kernel-low-bin-omitted",
            E + "ensemble/block.py",
            "                              ref, low_bin=low[j], noise=noise)  # fmt: skip",
