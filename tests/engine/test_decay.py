@@ -479,7 +479,7 @@ def test_a_floor_rising_with_the_motion_is_no_growth():
     reference trajectory decays by two decades or more, then rises again as its chaotic
     motion drifts from the reference's, and its floor with it.  That late rise is no
     growth that keeps the member from its one-step map, whose window may reach down to
-    ``GENERATOR_MARGIN`` times the floor (the forcing there enters the least-squares fit
+    ``LOW_MARGIN`` times the floor (the forcing there enters the least-squares fit
     weighted by ``‖g_k‖²``): every member 10× above its floor gets a β, the law's rate
     −ln ρ(R)/τ to 1 % (about 60 % did with the window ending 30× above the floor, and the
     rest were said not to decay although their verdicts said they decayed)."""

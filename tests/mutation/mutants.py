@@ -630,7 +630,7 @@ MUTANTS = [
            "a member that rose above its start reads a bin above the start's: no pairs"),
     Mutant("map-window-ends-30-above-the-floor",
            E + "decay/onestep.py",
-           "    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, GENERATOR_MARGIN):\n",
+           "    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, LOW_MARGIN):\n",
            "    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN):\n",
            ('tests/engine/test_decay.py::test_a_floor_rising_with_the_motion_is_no_growth',),
            "the one-step map's window never reaches below 30 times the floor"),

@@ -109,7 +109,8 @@ def _set_message(text: bytes, libc) -> None:
     """The handler's message, in its page, which is read-only again after the write (a
     stray write there faults, and the handler still has its message)."""
     at = ctypes.addressof(_MESSAGE)
-    libc["mprotect"](at, _PAGE, mmap.PROT_READ | mmap.PROT_WRITE)
+    if libc["mprotect"](at, _PAGE, mmap.PROT_READ | mmap.PROT_WRITE) != 0:
+        return  # (not writable: the message before stays)
     _MESSAGE.value = text
     libc["mprotect"](at, _PAGE, mmap.PROT_READ)
 

@@ -107,8 +107,8 @@ from .member import (  # noqa: F401
 )
 from .onestep import (  # noqa: F401
     CLUSTER,
-    GENERATOR_MARGIN,
     GENERATOR_SWEEPS,
+    LOW_MARGIN,
     MAP_BINS,
     MAP_MARGIN,
     MAP_MAX_NG,

@@ -60,8 +60,15 @@ CLUSTER = 0.02
 #: the floor's motion)
 MAP_RANK_TOL = 1e-12
 #: the pairs used lie above this many times the floor (then ``FLOOR_MARGIN``, then
-#: ``GENERATOR_MARGIN``)
+#: ``LOW_MARGIN``)
 MAP_MARGIN = 100.0
+#: the one-step map's and the generator's window may reach down to this many times the
+#: floor (after ``MAP_MARGIN`` and ``FLOOR_MARGIN``): what is left there is the forcing
+#: of the member's distance from the reference by the motion (the scheme's local errors
+#: along two trajectories; on adaptive steps, also steps that fall apart from the
+#: reference's), which enters the least-squares fit weighted by ``‖g_k‖²``: the
+#: transient's top sets the fit, and the forcing moves the rate by about ``floor / top``
+LOW_MARGIN = 10.0
 #: all pairs are used when the largest norm fell from each of the last three fifths to
 #: the next, by this factor from the third to the fifth: the run ended inside the
 #: transient, where the largest norm of the last fifth is no floor (the map needs no
@@ -770,7 +777,7 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
 
     The residual's pairs ``(g_k, g_{k+1})``, all of them when the run ended while it was
     still decaying (``MAP_STILL_DECAYING``), else those from its start until its level
-    first fell below ``MAP_MARGIN`` (then ``FLOOR_MARGIN``, then ``GENERATOR_MARGIN``)
+    first fell below ``MAP_MARGIN`` (then ``FLOOR_MARGIN``, then ``LOW_MARGIN``)
     times its floor (rounded up to a bin of :func:`map_buffers`; for a member that rose
     above its start, at most to the start's bin, which holds the rise), give ``R̂`` by
     least squares; ``β = −ln ρ(R̂)/τ``.
@@ -797,7 +804,7 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
     still = (meas[row, C_D2] > meas[row, C_D3] > meas[row, C_D4]
              and meas[row, C_D2] >= MAP_STILL_DECAYING * meas[row, C_D4])  # fmt: skip
     per_decade = LEVELS_PER_OCTAVE * math.log2(10.0) * MIN_DECADES
-    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, GENERATOR_MARGIN):
+    for margin in (-1.0, MAP_MARGIN, FLOOR_MARGIN, LOW_MARGIN):
         if margin < 0.0:  # still decaying: the last fifth's largest norm is no floor
             if not still:
                 continue
@@ -867,13 +874,6 @@ def map_estimate(S, j, ng, pm, lt, lv, base_j, meas, codes, row, tau, rt, ry, re
 #: trapezoidal fit's ``(hβ)²/12`` by about another ``(hβ)²/12``; the third is past
 #: roundoff for ``hβ < 0.5``)
 GENERATOR_SWEEPS = 3
-#: the one-step map's and the generator's window may reach down to this many times the
-#: floor (after ``MAP_MARGIN`` and ``FLOOR_MARGIN``): what is left there is the forcing
-#: of the member's distance from the reference by the motion (the scheme's local errors
-#: along two trajectories; on adaptive steps, also steps that fall apart from the
-#: reference's), which enters the least-squares fit weighted by ``‖g_k‖²``: the
-#: transient's top sets the fit, and the forcing moves the rate by about ``floor / top``
-GENERATOR_MARGIN = 10.0
 
 
 @njit(cache=True)

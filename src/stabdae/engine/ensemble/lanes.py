@@ -15,7 +15,7 @@ from numba import njit
 
 from ..cache import Spec, keyed_cache, memo, tag
 from ..decay import (
-    GENERATOR_MARGIN,
+    LOW_MARGIN,
     MAP_BINS,
     MAP_SHIFT,
     begin,
@@ -219,11 +219,11 @@ def _build_adaptive_block(K, spec: Spec):
         floor_min = 0.0
         for k in range(NR):
             for l in range(1, g_ref.shape[1]):
-                floor_min = max(floor_min, abs(g_ref[k, l]) / (10.0 * GENERATOR_MARGIN))
+                floor_min = max(floor_min, abs(g_ref[k, l]) / (10.0 * LOW_MARGIN))
         # no window is cut below this (the generator's last margin over floor_min): a
         # pair wholly below it is never read (its bins are filled before it, and a run
         # that ended still decaying fits the pairs above it), and is not summed
-        cut_min = GENERATOR_MARGIN * floor_min
+        cut_min = LOW_MARGIN * floor_min
         rec = out.g_out.shape[0] > 0  # the first member's (t, g) at every accepted step
         norms, meas, mcodes, x_final = out.norms, out.meas, out.codes, out.x_final
         status, fail_step, e0, e1 = out.status, out.fail_step, out.e0, out.e1
