@@ -86,6 +86,17 @@ def load_scene(name: str) -> stabdae.Model:
     return stabdae.load_model(KERNELS / f"{name}.py")
 
 
+#: models with a kinematic map ``q̇ = T v`` (quaternions with body angular velocities): the
+#: two rigid-body scenes and a rolling ball written as a user writes one (its rolling
+#: constraints depend on the orientation, so ``h_q T v`` is exercised)
+KINEMATIC = {"heavy_top": KERNELS / "heavy_top.py", "free_body": KERNELS / "free_body.py",
+             "quaternion_ball": ROOT / "tests" / "models" / "quaternion_ball.py"}
+
+
+def load_kinematic(name: str) -> stabdae.Model:
+    return stabdae.load_model(KINEMATIC[name])
+
+
 def scene_module(name: str):
     """The scene's module (for its closed-form helpers)."""
     from stabdae._loading import module_name

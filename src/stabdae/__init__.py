@@ -2,8 +2,8 @@
 numerical integration, after R. G. Mukharlyamov's constraint-perturbation equations.
 
 The public API is exactly what this module re-exports, plus the submodules
-:mod:`stabdae.theory`, :mod:`stabdae.symbolic`, :mod:`stabdae.simdmath` and
-:mod:`stabdae.plots`.  The floors
+:mod:`stabdae.theory`, :mod:`stabdae.symbolic`, :mod:`stabdae.simdmath`,
+:mod:`stabdae.rigid` and :mod:`stabdae.plots`.  The floors
 below it: :mod:`stabdae.engine` (compiled), the drivers and definitions here,
 :mod:`stabdae.study` (study files, runs, command line).
 """
@@ -56,7 +56,8 @@ _EXPORTS = {
     "two_stage": "_schemes",
     "Sequential": "_sequential",
 }
-_SUBMODULES = frozenset({"engine", "plots", "simdmath", "study", "symbolic", "theory"})
+_SUBMODULES = frozenset({"engine", "plots", "rigid", "simdmath", "study", "symbolic",
+                         "theory"})
 
 if TYPE_CHECKING:  # what the names are, for type checkers and the API reference
     from . import theory

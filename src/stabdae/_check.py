@@ -5,10 +5,12 @@ What is compared (central differences, step ``h = ε^{1/3} max(1, |x_j|)``):
 ========== ==============================================================
 f_q        ∂f/∂q
 f_t        ∂f/∂t (zero when the model declares no f_t)
-f_accel    d/dt (f_q v + f_t) along q̇ = v: ``(d/dt f_q) v + d/dt f_t``
+f_accel    d/dt (f_q T v + f_t) along q̇ = T v at fixed v (T = I without a kinematic
+           map): ``(d/dt (f_q T)) v + d/dt f_t``
 h_q, h_v   ∂h/∂q, ∂h/∂v
 h_t        ∂h/∂t (zero when the model declares no h_t)
 mass       symmetric to 1e-12 relative, and positive definite
+kinematics T (n × n) invertible: its condition number below 1e12
 sparsity   every non-zero of mass, f_q, h_q, h_v inside the pattern the model
            declared or detected (the sparse right-hand side reads nothing else)
 ========== ==============================================================
@@ -238,12 +240,22 @@ def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> N
         add("f_t", ev("f_t", t, x, p), _scalar_derivative(lambda s: ev("f", s, x, p), t), f0,
             "" if "f_t" in model.functions else "model declares none")  # fmt: skip
 
-        def fdot(s):  # ḟ along the motion q(s) = q + (s − t) v
-            xx = np.concatenate([q + (s - t) * v, v])
-            return ev("f_q", s, xx, p) @ v + ev("f_t", s, xx, p)
+        T0 = ev("kinematics", t, x, p)  # the identity without a kinematic map
 
-        # ḟ's terms, not ḟ itself (near zero on the manifold): their roundoff
-        terms = size(np.abs(ev("f_q", t, x, p)) @ np.abs(v)) + size(ev("f_t", t, x, p))
+        def fdot(s):  # ḟ along the motion q(s) = q + (s − t) T v at fixed v
+            xx = np.concatenate([q + (s - t) * (T0 @ v), v])
+            qdot = ev("kinematics", s, xx, p) @ v if model.kinematic else v
+            return ev("f_q", s, xx, p) @ qdot + ev("f_t", s, xx, p)
+
+        def terms_at(s):  # ḟ's terms, not ḟ itself (near zero on the manifold)
+            xx = np.concatenate([q + (s - t) * (T0 @ v), v])
+            Ts = np.abs(ev("kinematics", s, xx, p))
+            return size(np.abs(ev("f_q", s, xx, p)) @ Ts @ np.abs(v)) + size(ev("f_t", s, xx, p))
+
+        # their roundoff, at the states differenced (where a structural zero at x, such as
+        # a quaternion's at the identity, does not hold)
+        h = _EPS3 * max(1.0, abs(t))
+        terms = terms_at(t) if not model.kinematic else max(terms_at(t - h), terms_at(t + h))
         add("f_accel", ev("f_accel", t, x, p), _scalar_derivative(fdot, t), terms)
     if model.k:
         h0 = size(ev("h", t, x, p))
@@ -263,6 +275,11 @@ def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> N
             detail = (f"{piece} out{entry} = {float(value[tuple(entry)])!r}, an entry its "
                       f"sparsity pattern ({how}) marks structurally zero")
         report.rows.append(CheckRow("sparsity", i, worst, 0.0, detail))
+    if model.kinematic:
+        sv = np.linalg.svd(ev("kinematics", t, x, p), compute_uv=False)
+        cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+        report.rows.append(CheckRow("kinematics", i, cond, 1e12,
+                                    f"condition number of T {cond:.3e}"))  # fmt: skip
     if model.has_mass:
         M = ev("mass", t, x, p)
         asym = float(np.max(np.abs(M - M.T)))

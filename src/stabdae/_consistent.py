@@ -2,8 +2,8 @@
 coordinates and velocities held, the rest solved for by Newton's method.
 
 Two systems, one after the other: the positions from ``f(q, t) = 0`` in the coordinates
-not held, then the velocities from ``ḟ = F_q v + f_t = 0`` and ``h(q, v, t) = 0`` in the
-velocities not held.  Each is solved by Gauss–Newton steps (least squares on the free
+not held, then the velocities from ``ḟ = f_q T v + f_t = 0`` (T the model's kinematic
+map, the identity without one) and ``h(q, v, t) = 0`` in the velocities not held.  Each is solved by Gauss–Newton steps (least squares on the free
 unknowns, so that redundant but consistent constraints are allowed) from the starting
 state; a system whose free unknowns the constraints do not determine (under-determined)
 is refused before anything is solved, naming the unknowns left free, and one whose
@@ -36,9 +36,9 @@ def consistent_state(model: Model, fixed=None, *, guess=None, params=None, t=Non
     Parameters
     ----------
     fixed : mapping
-        State components to hold, by name (a coordinate, as ``model.coordinates``, or its
-        velocity, ``<name>_dot``, as ``model.state_names``) or index into ``x``, to their
-        values.  Every other component is an unknown.
+        State components to hold, by name (a coordinate, as ``model.coordinates``, or a
+        velocity, as ``model.velocities``: ``<name>_dot`` unless the model names them) or
+        index into ``x``, to their values.  Every other component is an unknown.
     guess : array (2n,), optional
         Where Newton's method starts (default: the reference state); it picks the branch
         where the constraints have several solutions (a mechanism's assembly modes).
@@ -91,8 +91,8 @@ def consistent_state(model: Model, fixed=None, *, guess=None, params=None, t=Non
     if model.m or model.k:
         def velocities(xx):
             res, jac = [], []
-            if model.m:
-                fq = model.evaluate("f_q", t, xx, p)
+            if model.m:  # F's holonomic rows along the kinematic map: f_q T
+                fq = model.evaluate("f_q", t, xx, p) @ model.evaluate("kinematics", t, xx, p)
                 res.append(fq @ xx[n:] + model.evaluate("f_t", t, xx, p))
                 jac.append(fq)
             if model.k:

@@ -14,8 +14,19 @@ f_accel     ``f_accel(t, q, v, p, out)`` (m,)      m > 0: ``(d/dt f_q) v + d/dt 
 h           ``h(t, q, v, p, out)``       (k,)      k > 0 nonholonomic constraints
 h_q, h_v    ``(t, q, v, p, out)``        (k, n)    k > 0
 h_t         ``h_t(t, q, v, p, out)``     (k,)      time-dependent nonholonomic only
+kinematics  ``kinematics(t, q, p, out)`` (n, n)    quasi-velocities only: T of ``q̇ = T v``
 energy      ``energy(t, q, v, p)``       float     optional, for drift diagnostics
 =========== ============================ ========= ==========================================
+
+Without ``kinematics`` the velocities are the coordinates' derivatives, ``q̇ = v``.  With
+it they are quasi-velocities (a rigid body's angular velocity in its body frame beside a
+unit quaternion, :mod:`stabdae.rigid`): ``q̇ = T(q, t) v``, ``mass`` and ``forces`` are
+those of the equations written in ``v`` (``M v̇ = Fᵀλ − γ``, the gyroscopic terms in γ),
+``f_q`` is still ``∂f/∂q`` and ``h_q`` ``∂h/∂q`` (the library takes F's holonomic rows as
+``f_q T`` and the velocity products as ``h_q T v``), and ``f_accel`` is the derivative
+of ``ḟ = f_q T v + f_t`` along the motion at fixed v: ``(d/dt (f_q T)) v + d/dt f_t``.
+T is square, so the state stays ``x = (q, v)`` of size 2n; :meth:`Model.check` compares
+``f_accel`` with finite differences of ``ḟ`` along ``q̇ = T v``.
 """
 
 from __future__ import annotations
@@ -59,6 +70,7 @@ _PIECES: dict[str, tuple[str, Callable[[int, int, int], tuple[int, ...]], str]] 
     "h_q": ("tqvp", lambda n, m, k: (k, n), "k, n"),
     "h_v": ("tqvp", lambda n, m, k: (k, n), "k, n"),
     "h_t": ("tqvp", lambda n, m, k: (k,), "k"),
+    "kinematics": ("tqp", lambda n, m, k: (n, n), "n"),
 }
 _UNSET = object()
 #: pieces whose structural zeros the sparse right-hand side uses
@@ -106,6 +118,14 @@ class Model:
         The pieces of the model; see the module docstring for signatures.  ``forces`` is
         required; the constraint pieces follow from ``m`` and ``k``; ``mass`` (identity
         when absent), ``f_t``, ``h_t`` (scleronomic when absent) and ``energy`` are optional.
+    kinematics : numba dispatcher ``kinematics(t, q, p, out)``, optional
+        The kinematic map T (n × n) of quasi-velocities, ``q̇ = T(q, t) v`` (module
+        docstring); absent, ``q̇ = v``.  A model with a map takes the dense right-hand side.
+    velocities : sequence of str, optional
+        Names of the n velocities (default ``<coordinate>_dot``; name them where they are
+        quasi-velocities, ``omega_x`` beside a quaternion's ``p0 … p3``).
+    velocity_units : str or sequence of str, optional
+        Their UDUNITS units (default each coordinate's per second).
     t0 : float, default 0.0
         Time at which ``reference_state`` is consistent.
     sparsity : {"detect", "sparse", "dense"} or mapping, default "detect"
@@ -173,6 +193,9 @@ class Model:
         h_v: Dispatcher | None = None,
         h_t: Dispatcher | None = None,
         energy: Dispatcher | None = None,
+        kinematics: Dispatcher | None = None,
+        velocities: Sequence[str] | None = None,
+        velocity_units: Sequence[str] | str | None = None,
         coordinates: Sequence[str] | None = None,
         coordinate_units: Sequence[str] | str | None = None,
         constraint_units: Sequence[str] | str | None = None,
@@ -207,6 +230,14 @@ class Model:
         self.coordinates = self._validate_names(coordinates)
         self.coordinate_units = self._validate_units(coordinate_units, self.n, "coordinate_units",
                                                      "n")
+        self.velocities = (tuple(f"{c}_dot" for c in self.coordinates) if velocities is None
+                           else self._validate_names(velocities, "velocities"))
+        if set(self.velocities) & set(self.coordinates):
+            raise ModelError(f"Model {self.name!r}: velocity names repeat coordinate names: "
+                             f"{sorted(set(self.velocities) & set(self.coordinates))}")
+        self.velocity_units = (
+            tuple(_per_second(u) for u in self.coordinate_units) if velocity_units is None
+            else self._validate_units(velocity_units, self.n, "velocity_units", "n"))
         self.constraint_units = self._validate_units(constraint_units, self.m + self.k,
                                                      "constraint_units", "r = m + k")
         self.energy_units = str(energy_units)
@@ -214,7 +245,7 @@ class Model:
 
         given = dict(
             mass=mass, forces=forces, f=f, f_q=f_q, f_t=f_t, f_accel=f_accel,
-            h=h, h_q=h_q, h_v=h_v, h_t=h_t,
+            h=h, h_q=h_q, h_v=h_v, h_t=h_t, kinematics=kinematics,
         )  # fmt: skip
         self._check_presence(given)
         self.functions: dict[str, Dispatcher] = {}
@@ -233,6 +264,10 @@ class Model:
         outputs = self._probe_all(x_ref, p)
         self._check_consistent(x_ref, p)
         self.patterns = self._sparsity(sparsity, x_ref, p, outputs)
+        if self.kinematic and self._sparsity_mode == "sparse":
+            raise ModelError(f"Model {self.name!r}: sparsity='sparse' is not available with a "
+                             "kinematic map (F's rows f_q T fill in): use 'detect' or "
+                             "'dense'")  # fmt: skip
         self._structure = _UNSET  # sparse_structure(), made when first asked for
         self._kernel_cache: dict = {}
 
@@ -261,12 +296,17 @@ class Model:
         return tuple(self.params)
 
     @property
+    def kinematic(self) -> bool:
+        """True when the velocities are quasi-velocities, ``q̇ = T(q, t) v``."""
+        return "kinematics" in self.functions
+
+    @property
     def state_names(self) -> list[str]:
-        return list(self.coordinates) + [f"{c}_dot" for c in self.coordinates]
+        return list(self.coordinates) + list(self.velocities)
 
     @functools.cached_property  # (the declarations are fixed at construction)
     def state_units(self) -> list[str]:
-        return list(self.coordinate_units) + [_per_second(u) for u in self.coordinate_units]
+        return list(self.coordinate_units) + list(self.velocity_units)
 
     @functools.cached_property  # (the declarations are fixed at construction)
     def component_units(self) -> list[str]:
@@ -390,7 +430,7 @@ class Model:
         shape = shape_of(self.n, self.m, self.k)
         fn = self.functions.get(piece)
         if fn is None:
-            if piece == "mass":
+            if piece in ("mass", "kinematics"):
                 return np.eye(self.n)
             return np.zeros(shape)
         out = np.zeros(shape)
@@ -425,7 +465,8 @@ class Model:
             return self._value(piece, t, x, p, python)
 
         if self.m:
-            parts += [value("f"), value("f_q") @ v + value("f_t")]
+            qdot = value("kinematics") @ v if self.kinematic else v
+            parts += [value("f"), value("f_q") @ qdot + value("f_t")]
         if self.k:
             parts.append(value("h"))
         return np.concatenate(parts)
@@ -530,17 +571,21 @@ class Model:
                                  "NetCDF attribute)")  # fmt: skip
         return {str(k): _finite_float(v, f"parameter {k!r}") for k, v in params.items()}
 
-    def _validate_names(self, coordinates) -> tuple[str, ...]:
+    def _validate_names(self, coordinates, what: str = "coordinates") -> tuple[str, ...]:
         if coordinates is None:
             return tuple(f"q{i}" for i in range(self.n))
+        if isinstance(coordinates, str):
+            raise ModelError(f"Model {self.name!r}: {what} must be a sequence of n={self.n} "
+                             f"names, got the string {coordinates!r}")  # fmt: skip
         names = tuple(str(c) for c in coordinates)
         if len(names) != self.n:
             raise ModelError(
-                f"Model {self.name!r}: coordinates must name the n={self.n} coordinates, "
+                f"Model {self.name!r}: {what} must name the n={self.n} {what}, "
                 f"got {len(names)}: {list(names)}"
             )
         if len(set(names)) != len(names):
-            raise ModelError(f"Model {self.name!r}: coordinate names repeat: {list(names)}")
+            one = "coordinate" if what == "coordinates" else "velocity"
+            raise ModelError(f"Model {self.name!r}: {one} names repeat: {list(names)}")
         return names
 
     def _validate_units(self, units, count: int, what: str, size: str) -> tuple[str, ...]:
@@ -728,7 +773,8 @@ class Model:
         from .engine.sparsity import dense_cost, sparse_cost, structure
 
         st = None
-        pats = self.patterns
+        # a kinematic map fills F's holonomic rows (f_q T): the dense path
+        pats = None if self.kinematic else self.patterns
         diagonal = not self.has_mass or (
             pats is not None and not (pats["mass"] & ~np.eye(self.n, dtype=bool)).any())
         if pats is not None and diagonal:

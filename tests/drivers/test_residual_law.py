@@ -14,7 +14,7 @@ from numba import njit
 from scipy.linalg import expm
 
 import stabdae
-from conftest import SCENES, load_scene, perturbed_state
+from conftest import KINEMATIC, SCENES, load_kinematic, load_scene, perturbed_state
 
 TAU, T_END, SAVE = 5e-4, 2.0, 0.05
 
@@ -54,6 +54,18 @@ def test_residual_follows_expm(name, law_name):
     law = constant_laws(model)[law_name]
     x0 = perturbed_state(model, 1e-3, seed=7)
     assert np.max(np.abs(model.residual(x0))) > 1e-5  # a real perturbation
+    assert relative_law_error(model, law, x0) <= 1e-6
+
+
+@pytest.mark.parametrize("law_name", ["baumgarte", "matrix"])
+@pytest.mark.parametrize("name", list(KINEMATIC))
+def test_residual_follows_expm_with_a_kinematic_map(name, law_name):
+    """The same law for quasi-velocities (q̇ = T v): the quaternion's norm and, for the
+    rolling ball, constraints on the orientation and the angular velocity together."""
+    model = load_kinematic(name)
+    law = constant_laws(model)[law_name]
+    x0 = perturbed_state(model, 1e-3, seed=7)
+    assert np.max(np.abs(model.residual(x0))) > 1e-5
     assert relative_law_error(model, law, x0) <= 1e-6
 
 

@@ -14,6 +14,12 @@ Per evaluation (the paper's §3)::
 
 so that ``(f̈; ḣ) = S λ + s = A g`` and the exact flow obeys ``ġ = Ã g`` (3.9).
 
+A model with a kinematic map ``q̇ = T(q, t) v`` (quasi-velocities: a rigid body's angular
+velocity beside its orientation's quaternion) takes F's holonomic rows along the map,
+``f_q T``, its velocity products ``h_q T v``, and ``q̇ = T v``; every other line is the
+same, so the residual obeys the same law.  Such a model takes the dense path (the map
+fills the patterns the sparse and written-out paths are built on).
+
 The kernel factory closes over the model's dispatchers and over compile-time flags (mass
 present, m, k, time dependence, law kind).  Absent pieces are replaced by no-op stubs
 behind branches on those constants, which LLVM removes: an identity-mass model compiles
@@ -221,6 +227,7 @@ class Pieces(NamedTuple):
     ng: int
     HAS_MASS: bool
     HAS_HT: bool
+    HAS_KIN: bool
     SPARSE: bool
     mass: object
     forces: object
@@ -295,6 +302,7 @@ def _pieces(model, sparse: bool) -> Pieces:
     HAS_MASS = "mass" in fns
     HAS_FT = "f_t" in fns
     HAS_HT = "h_t" in fns
+    HAS_KIN = "kinematics" in fns
     mass = _rejit(fns.get("mass"), _noop4)
     forces = _rejit(fns["forces"], None)
     f_fn = _rejit(fns.get("f"), _noop4)
@@ -305,10 +313,11 @@ def _pieces(model, sparse: bool) -> Pieces:
     h_q = _rejit(fns.get("h_q"), _noop5)
     h_v = _rejit(fns.get("h_v"), _noop5)
     h_t = _rejit(fns.get("h_t"), _noop5)
+    kinematics = _rejit(fns.get("kinematics"), _noop4)
     # inlined like the other pieces: a separately compiled user function would carry a
     # symbol name shared by every model's "energy" (see _cache.tag)
     energy_fn = _rejit(model.energy, _nan_energy)
-    make_workspace, stack_workspace = builders(n, m, k)
+    make_workspace, stack_workspace = builders(n, m, k, HAS_KIN)
     st = model.sparse_structure() if sparse else None
     SPARSE = st is not None
     # the dense path's products by F's velocity columns written out over the patterns' non-zeros
@@ -361,16 +370,34 @@ def _pieces(model, sparse: bool) -> Pieces:
 
     @internal(forceinline=True)
     def residual(t, x, p, ws, g):
-        """g = (f, f_q v + f_t, h) of (3.2) into ``g``; fills ws q, v, f_q, h_v, h_q."""
+        """g = (f, f_q v + f_t, h) of (3.2) into ``g``; fills ws q, v, f_q, h_v, h_q (and,
+        with a kinematic map, T, q̇ = T v and F's holonomic rows f_q T in ``fq``)."""
         q, v, fq, hv, hq, sm, sk = ws.q, ws.v, ws.fq, ws.hv, ws.hq, ws.sm, ws.sk
         for i in range(n):
             q[i] = x[i]
             v[i] = x[n + i]
+        if HAS_KIN:
+            Tw, qd, fr = ws.T, ws.qd, ws.fr
+            kinematics(t, q, p, Tw)
+            for i in range(n):
+                s = -0.0
+                for j in range(n):
+                    s = fma(Tw[i, j], v[j], s)
+                qd[i] = s
         if m > 0:
             f_fn(t, q, p, sm)
             for i in range(m):
                 g[i] = sm[i]
-            f_q(t, q, p, fq)
+            if HAS_KIN:  # F's holonomic rows along the map: ḟ = f_q T v + f_t
+                f_q(t, q, p, fr)
+                for i in range(m):
+                    for j in range(n):
+                        s = -0.0
+                        for c in range(n):
+                            s = fma(fr[i, c], Tw[c, j], s)
+                        fq[i, j] = s
+            else:
+                f_q(t, q, p, fq)
             if HAS_FT:
                 f_t(t, q, p, sm)
             if FQ_V:
@@ -450,11 +477,22 @@ def _pieces(model, sparse: bool) -> Pieces:
                 if ldl_inplace(S, cols, S_RTOL) != 0:
                     return _SINGULAR_S
                 ldl_solve_inplace(S, cols, rhs_)
+                dx = ws.z  # (the projection evaluates no forces)
                 for j in range(n):
                     s = -0.0
                     for i in range(cols):
                         s = fma(Y[j, i], rhs_[i], s)
-                    x[level * n + j] -= s
+                    dx[j] = s
+                if HAS_KIN and level == 0:  # a step in v's coordinates moves q by T δv
+                    Tw = ws.T
+                    for j in range(n):
+                        s = -0.0
+                        for c in range(n):
+                            s = fma(Tw[j, c], dx[c], s)
+                        x[j] -= s
+                else:
+                    for j in range(n):
+                        x[level * n + j] -= dx[j]
         return _OK
 
     @internal(error_model="numpy")
@@ -472,9 +510,9 @@ def _pieces(model, sparse: bool) -> Pieces:
     )  # fmt: skip
     key = Spec("pieces", sparse=sparse).key(model_key)
     tag(key, residual, energy, project, make_workspace, stack_workspace)
-    return Pieces(n, m, k, r, ng, HAS_MASS, HAS_HT, SPARSE, mass, forces, f_accel, h_t, residual,
-                  project, energy, make_workspace, stack_workspace, sparse_Y, sparse_S, hq_v,
-                  FPTR, FCOL, CPTR, CROW, HQPTR, HQCOL, LPTR, LCOL, LTPTR, LROW, key)  # fmt: skip
+    return Pieces(n, m, k, r, ng, HAS_MASS, HAS_HT, HAS_KIN, SPARSE, mass, forces, f_accel, h_t,
+                  residual, project, energy, make_workspace, stack_workspace, sparse_Y, sparse_S,
+                  hq_v, FPTR, FCOL, CPTR, CROW, HQPTR, HQCOL, LPTR, LCOL, LTPTR, LROW, key)
 
 
 def _velocity_products(model, has_ft: bool, has_ht: bool):
@@ -488,6 +526,8 @@ def _velocity_products(model, has_ft: bool, has_ht: bool):
     14 × 15 ``f_q``) stays inside the ensemble kernel's loop over the members, which is
     then no longer innermost and runs one member at a time."""
     pats, n, m, k = model.patterns, model.n, model.m, model.k
+    if "kinematics" in model.functions:  # the map fills f_q T; h_q multiplies T v
+        return _noop4, _noop4
     tag_ = model.structure_key()[:8] if pats is not None else ""
     out = []
     for rows, piece, has_t, header, start, term, dst in (
@@ -527,7 +567,7 @@ def _structured(model, n: int, m: int, k: int) -> Plan | None:
     """
     pats = model.patterns
     r = m + k
-    if pats is None or r == 0:
+    if pats is None or r == 0 or "kinematics" in model.functions:
         return None
     F = np.zeros((r, n), dtype=bool)
     if m:
@@ -596,7 +636,7 @@ def _build(model, spec: Spec) -> Kernels:
     P = memo(model, Spec("pieces", sparse=sparse), lambda: _pieces(model, sparse))
     # compile-time constants of the right-hand side's closure
     n, m, k, r, ng = P.n, P.m, P.k, P.r, P.ng
-    HAS_MASS, HAS_HT, SPARSE = P.HAS_MASS, P.HAS_HT, P.SPARSE
+    HAS_MASS, HAS_HT, HAS_KIN, SPARSE = P.HAS_MASS, P.HAS_HT, P.HAS_KIN, P.SPARSE
     mass, forces, f_accel, h_t = P.mass, P.forces, P.f_accel, P.h_t
     residual, project, energy = P.residual, P.project, P.energy
     make_workspace, stack_workspace = P.make_workspace, P.stack_workspace
@@ -642,6 +682,7 @@ def _build(model, spec: Spec) -> Kernels:
         q, v, Mw, z, fq, hv, hq = ws.q, ws.v, ws.M, ws.z, ws.fq, ws.hv, ws.hq
         Y, S, rl, g, sm, sk = ws.Y, ws.S, ws.rl, ws.g, ws.sm, ws.sk
         Aw, W, Lh = ws.Aw, ws.W, ws.Lh
+        vq = ws.qd if HAS_KIN else v  # q̇
         residual(t, x, p, ws, g)
         forces(t, q, v, p, z)
 
@@ -662,10 +703,10 @@ def _build(model, spec: Spec) -> Kernels:
                     if SPARSE:
                         for e in range(HQPTR[i], HQPTR[i + 1]):
                             j = HQCOL[e]
-                            s = fma(-hq[i, j], v[j], s)
+                            s = fma(-hq[i, j], vq[j], s)
                     else:
                         for j in range(n):
-                            s = fma(-hq[i, j], v[j], s)
+                            s = fma(-hq[i, j], vq[j], s)
                     rl[m + i] = s
         if LAW == LAW_CONSTANT:
             for i in range(r):
@@ -736,7 +777,7 @@ def _build(model, spec: Spec) -> Kernels:
                 for e in range(CPTR[j], CPTR[j + 1]):
                     i = CROW[e]
                     s = fma(Y[j, i], rl[i], s)
-                xdot[j] = v[j]
+                xdot[j] = vq[j]
                 xdot[n + j] = s
         elif STRUCTURED:
             load_Ft(fq, hv, Y)
@@ -749,7 +790,7 @@ def _build(model, spec: Spec) -> Kernels:
             gram(fq, hv, Y, S)
             bad_S = factor_S(S, r, S_RTOL) != 0
             solve_S(S, r, rl)  # rl is now λ
-            accel(Y, z, rl, v, xdot)
+            accel(Y, z, rl, vq, xdot)
         else:
             _load_Ft(fq, hv, Y, m, r, n)
             if HAS_MASS:
@@ -776,7 +817,7 @@ def _build(model, spec: Spec) -> Kernels:
                 s = -z[j]
                 for i in range(r):
                     s = fma(Y[j, i], rl[i], s)
-                xdot[j] = v[j]
+                xdot[j] = vq[j]
                 xdot[n + j] = s
         if LAW == LAW_ACPR:
             # − γ_s (δq, δv): δv = Y S⁻¹ (ḟ, h); δq = Y₁ P⁻¹ f with P = f_q M⁻¹ f_qᵀ the
@@ -797,8 +838,18 @@ def _build(model, spec: Spec) -> Kernels:
                 dv = -0.0
                 for i in range(r):
                     dv = fma(Y[j, i], mu[i], dv)
-                xdot[j] = fma(-gam, dq, xdot[j])
+                if HAS_KIN:
+                    z[j] = dq  # (z is spent): δq in v's coordinates, moved by T below
+                else:
+                    xdot[j] = fma(-gam, dq, xdot[j])
                 xdot[n + j] = fma(-gam, dv, xdot[n + j])
+            if HAS_KIN:
+                Tw = ws.T
+                for j in range(n):
+                    s = -0.0
+                    for c in range(n):
+                        s = fma(Tw[j, c], z[c], s)
+                    xdot[j] = fma(-gam, s, xdot[j])
         # the mass matrix's failure first (MASS_NOT_SPD > SINGULAR_S > OK = 0); arithmetic,
         # not branches, which LLVM sank the S test into and then could not vectorize
         return max(_MASS_NOT_SPD * bad_mass, _SINGULAR_S * bad_S)

@@ -10,7 +10,8 @@ constructors and every reader follow the one declaration.
 
 Sizes: ``n`` coordinates, ``m`` holonomic and ``k`` nonholonomic constraints,
 ``r = m + k``, ``ng = 2m + k`` residual components; ``mk = max(m, 1)`` and
-``kk = max(k, 1)``, so that the buffers of an absent block keep a harmless size 1.
+``kk = max(k, 1)``, so that the buffers of an absent block keep a harmless size 1, and
+``nt``, ``n`` for a model with a kinematic map ``q̇ = T(q, t) v`` and 1 without.
 
 :func:`stack1`, :func:`stack2` and :func:`stack_int1` give arrays on the stack of the
 function that calls them (inline that function at the numba IR level, as
@@ -54,27 +55,30 @@ LAYOUT = (
     ("ev", ("r",), "eigenvalues of S (least-squares multiplier)"),
     ("mu", ("r",), "size r: the correction's and the projection's velocity right side; "
      "the least-squares multiplier's scratch"),
+    ("T", ("nt", "nt"), "the kinematic map T(q, t) of q̇ = T v"),
+    ("fr", ("mk", "nt"), "∂f/∂q as the model writes it, before F's rows f_q T"),
+    ("qd", ("nt",), "q̇ = T v"),
 )  # fmt: skip
 
 Workspace = namedtuple("Workspace", [name for name, _, _ in LAYOUT])
 Workspace.__doc__ = "The named buffers of :data:`LAYOUT` (heap or stack arrays)."
 
 
-def sizes(n: int, m: int, k: int) -> dict:
-    """The sizes :data:`LAYOUT` is written in."""
+def sizes(n: int, m: int, k: int, kinematic: bool = False) -> dict:
+    """The sizes :data:`LAYOUT` is written in (``kinematic``: the model has a map T)."""
     return {"n": n, "m": m, "k": k, "r": m + k, "ng": 2 * m + k, "mk": max(m, 1),
-            "kk": max(k, 1)}  # fmt: skip
+            "kk": max(k, 1), "nt": n if kinematic else 1}  # fmt: skip
 
 
-def shapes(n: int, m: int, k: int) -> dict:
+def shapes(n: int, m: int, k: int, kinematic: bool = False) -> dict:
     """``name -> shape`` of every buffer for a model of sizes ``n, m, k``."""
-    dim = sizes(n, m, k)
+    dim = sizes(n, m, k, kinematic)
     return {name: tuple(dim[d] for d in shape) for name, shape, _ in LAYOUT}
 
 
-def _builder_source(n: int, m: int, k: int) -> str:
+def _builder_source(n: int, m: int, k: int, kinematic: bool) -> str:
     heap, stack = [], []
-    for shape in shapes(n, m, k).values():
+    for shape in shapes(n, m, k, kinematic).values():
         heap.append(f"np.empty({shape})")
         stack.append(f"stack{len(shape)}({', '.join(map(str, shape))})")
     return (
@@ -85,12 +89,14 @@ def _builder_source(n: int, m: int, k: int) -> str:
     )
 
 
-def builders(n: int, m: int, k: int):
-    """``(make_workspace, stack_workspace)`` for a model of sizes ``n, m, k``: compiled
+def builders(n: int, m: int, k: int, kinematic: bool = False):
+    """``(make_workspace, stack_workspace)`` for a model of sizes ``n, m, k`` (with a
+    kinematic map: ``kinematic``): compiled
     constructors of :class:`Workspace` with heap and with stack arrays, generated from
     :data:`LAYOUT`.  ``stack_workspace`` is inlined at the numba IR level (its stack
     buffers belong to the caller)."""
-    ns = exec_source(_builder_source(n, m, k), f"workspace_n{n}_m{m}_k{k}",
+    ns = exec_source(_builder_source(n, m, k, kinematic),
+                     f"workspace_n{n}_m{m}_k{k}" + ("_T" if kinematic else ""),
                      {"np": np, "Workspace": Workspace, "stack1": stack1,
                       "stack2": stack2})  # fmt: skip
     return (internal(error_model="numpy")(ns["make_workspace"]),
