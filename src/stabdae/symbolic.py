@@ -12,6 +12,10 @@ Hand-deriving ``γ``, ``f_accel`` and the Jacobians is where model files go wron
 * ``h_q``, ``h_v``, ``h_t``,
 * the energy (Jacobi integral) ``E = q̇ᵀ ∂L/∂q̇ − L``,
 
+or, for a spec that gives a kinematic map ``q̇ = T(q, t) v`` (quasi-velocities: a rigid
+body's angular velocity beside its quaternion) and its Lagrangian in ``v``, the equations
+in ``v`` (Hamel's form, below) and ``f_accel = (d/dt (f_q T)) v + d/dt f_t``,
+
 and :meth:`System.source` writes them as a model file of ``@njit`` functions, each with
 its common subexpressions eliminated, in the same shape as the hand-written scenes of
 ``kernels/``.  From the command line: ``stabdae generate SPEC.py -o kernels/NAME.py``.
@@ -64,7 +68,7 @@ t = sp.Symbol("t")
 #: names the generated functions use for their own arguments and modules
 _RESERVED = {"t", "q", "v", "p", "out", "math", "np", "njit", "stabdae", "simdmath", "model",
              "reference_state", "mass", "forces", "f", "f_q", "f_t", "f_accel", "h",
-             "h_q", "h_v", "h_t", "energy"}  # fmt: skip
+             "h_q", "h_v", "h_t", "energy", "kinematics"}  # fmt: skip
 _WIDTH = 100
 _SPACED = re.compile(r"\s*((?<!\*)\*(?!\*)|/)\s*")
 
@@ -115,7 +119,17 @@ class System:
     reference_state : sequence of 2n expressions in the parameters
         A consistent state ``x* = (q*, v*)`` at ``t0``.
     forces : sequence of n sympy expressions, optional
-        Non-conservative generalized forces ``Q(q, v, t)`` (default none).
+        Non-conservative generalized forces ``Q(q, v, t)`` (default none); with a
+        kinematic map, those conjugate to ``v`` (a body's torque in its body frame).
+    kinematics : n × n sympy matrix of (q, t), optional
+        A kinematic map ``q̇ = T(q, t) v``: ``v`` are then quasi-velocities and the
+        Lagrangian is written in them, ``L*(q, v, t) = L(q, T v, t)``.  The equations
+        of motion in ``v`` are Hamel's: with ``W = T⁻¹`` and ``p* = ∂L*/∂v``,
+        ``d/dt p*_k + Σ_{i,r,j} T_ik p*_r (∂W_ri/∂q_j − ∂W_rj/∂q_i) q̇_j
+        + Σ_{i,r} T_ik p*_r ∂W_ri/∂t − Σ_i T_ik ∂L*/∂q_i = Q_k + (Fᵀλ)_k`` (the Lagrange
+        equations in ``q`` multiplied by ``Tᵀ``), so that ``γ`` holds the gyroscopic
+        terms.  The generated model declares ``kinematics`` and names its velocities
+        after ``v``.
     energy : sympy expression, bool, default True
         ``True`` derives the Jacobi integral ``vᵀ ∂L/∂v − L``; an expression is used as
         given; ``False`` omits the energy function.
@@ -168,6 +182,7 @@ class System:
         params: Mapping | None = None,
         reference_state: Sequence,
         forces: Sequence | None = None,
+        kinematics=None,
         energy=True,
         t: sp.Symbol = t,
         coordinate_units: Sequence[str] | None = None,
@@ -205,6 +220,10 @@ class System:
         if self.Q is not None and len(self.Q) != self.n:
             raise SymbolicError(f"System {self.name!r}: forces must have n = {self.n} "
                                 f"entries, got {len(self.Q)}")  # fmt: skip
+        self.T = None if kinematics is None else sp.Matrix(kinematics)
+        if self.T is not None and self.T.shape != (self.n, self.n):
+            raise SymbolicError(f"System {self.name!r}: kinematics must be an n × n = "
+                                f"{self.n} × {self.n} matrix, got {self.T.shape}")
         self.x_ref = [sp.sympify(e) for e in reference_state]
         if len(self.x_ref) != 2 * self.n:
             raise SymbolicError(
@@ -254,6 +273,10 @@ class System:
                 check(e, f"forces[{i}]", allowed)
         for i, e in enumerate(self.x_ref):
             check(e, f"reference_state[{i}] (parameters only)", p_set)
+        if self.T is not None:
+            for (i, j), e in np.ndenumerate(np.array(self.T.tolist(), dtype=object)):
+                check(sp.sympify(e), f"kinematics[{i}, {j}] (T(q, t): no velocities)",
+                      q_set | p_set | {self.t})
         if self.energy_spec not in (True, False):
             check(sp.sympify(self.energy_spec), "energy", allowed)
 
@@ -291,7 +314,11 @@ class System:
         # The velocity terms are one derivative along (v, 1) per entry rather than a row of
         # n partial derivatives dotted with v: the same values, and the nested sums of a
         # Lagrangian in joint angles stay sums instead of growing a term per coordinate.
-        gamma = self._along(p_v) - sp.Matrix([sp.diff(self.L, s) for s in self.q])
+        L_q = sp.Matrix([sp.diff(self.L, s) for s in self.q])
+        if self.T is None:
+            gamma = self._along(p_v) - L_q
+        else:
+            gamma = self._hamel(p_v, L_q)
         if self.Q is not None:
             gamma -= self.Q
         out: dict = {}
@@ -306,8 +333,12 @@ class System:
             f_t = self._cancel(f_t.applyfunc(clean))
             if any(e != 0 for e in f_t):
                 out["f_t"] = f_t
-            # (∂ḟ/∂q) v + ∂ḟ/∂t is f's second derivative along (v, 1)
-            out["f_accel"] = self._along(self.f, order=2).applyfunc(clean)
+            if self.T is None:
+                # (∂ḟ/∂q) v + ∂ḟ/∂t is f's second derivative along (v, 1)
+                out["f_accel"] = self._along(self.f, order=2).applyfunc(clean)
+            else:
+                # ḟ = f_q T v + f_t, then its derivative along (T v, 1) at fixed v
+                out["f_accel"] = self._along(self._along(self.f)).applyfunc(clean)
         if self.k:
             out["h"] = self.h.applyfunc(clean)
             out["h_q"] = self._cancel(self.h.jacobian(q).applyfunc(clean))
@@ -315,7 +346,10 @@ class System:
             h_t = self._cancel(self.h.diff(t_).applyfunc(clean))
             if any(e != 0 for e in h_t):
                 out["h_t"] = h_t
+        if self.T is not None:
+            out["kinematics"] = self._cancel(self.T.applyfunc(clean))
         if self.energy_spec is True:
+            # (with a kinematic map the same integral: vᵀ ∂L*/∂v = q̇ᵀ ∂L/∂q̇)
             # vᵀ ∂L/∂v is the derivative of L(q, (1 + ε) v, t) at ε = 0: one derivative of
             # L instead of n, sharing L's own subexpressions
             eps = sp.Dummy("eps")
@@ -367,12 +401,42 @@ class System:
                 out[i] = sp.S.Zero
         return out
 
+    def _qdot(self) -> list:
+        """``q̇`` in the velocities: ``v``, or ``T v`` with a kinematic map."""
+        if self.T is None:
+            return list(self.v)
+        return list(self.T * sp.Matrix(self.v))
+
+    def _hamel(self, p_v: sp.Matrix, L_q: sp.Matrix) -> sp.Matrix:
+        """γ of the equations in quasi-velocities (the ``kinematics`` parameter): the
+        derivative of ``p* = ∂L*/∂v`` along the motion without ``M v̇``, the Hamel terms
+        of ``W = T⁻¹``, minus ``Tᵀ ∂L*/∂q``."""
+        T, n = self.T, self.n
+        W = T.inv().applyfunc(sp.simplify if self.simplify else sp.expand)
+        qdot = self._qdot()
+        hamel = []
+        for k in range(n):
+            term = sp.S.Zero
+            for i in range(n):
+                if T[i, k] == 0:
+                    continue
+                inner = sp.S.Zero
+                for r in range(n):
+                    if p_v[r] == 0:
+                        continue
+                    rot = sum(((sp.diff(W[r, i], self.q[j]) - sp.diff(W[r, j], self.q[i]))
+                               * qdot[j] for j in range(n)), sp.S.Zero)
+                    inner += p_v[r] * (rot + sp.diff(W[r, i], self.t))
+                term += T[i, k] * inner
+            hamel.append(term)
+        return self._along(p_v) + sp.Matrix(hamel) - T.T * L_q
+
     def _along(self, expr: sp.Matrix, order: int = 1) -> sp.Matrix:
-        """The ``order``-th derivative of ``expr(q, ·, t)`` along ``(v, 1)``: entries of
-        ``d^k/dε^k expr(q + ε v, ·, t + ε)`` at ε = 0 (the velocities left in ``expr`` are
-        held)."""
+        """The ``order``-th derivative of ``expr(q, ·, t)`` along ``(q̇, 1)``: entries of
+        ``d^k/dε^k expr(q + ε q̇, ·, t + ε)`` at ε = 0 (the velocities left in ``expr`` are
+        held; ``q̇ = v``, or ``T v`` at the base point with a kinematic map)."""
         eps = sp.Dummy("eps")
-        shift = {s: s + eps * w for s, w in zip(self.q, self.v)}
+        shift = {s: s + eps * w for s, w in zip(self.q, self._qdot())}
         shift[self.t] = self.t + eps
         return expr.xreplace(shift).applyfunc(lambda e: sp.diff(e, eps, order).xreplace({eps: 0}))
 
@@ -390,7 +454,7 @@ class System:
         names = _LocalNames(self)
         code = []
         for piece, expr in pieces.items():
-            text, self.operations[piece] = _function(piece, expr, names)
+            text, self.operations[piece] = _function(piece, expr, names, self.T is not None)
             code.append(text)
         code.append(self._reference_function(names))
         imports = _IMPORTS
@@ -462,6 +526,8 @@ class System:
         args.append(params)
         args.append("reference_state=reference_state")
         args.append("coordinates=[" + ", ".join(_quote(str(s)) for s in self.q) + "]")
+        if self.T is not None:  # quasi-velocities: named as the spec names them
+            args.append("velocities=[" + ", ".join(_quote(str(s)) for s in self.v) + "]")
         for name in ("coordinate_units", "constraint_units"):
             units = getattr(self, name)
             if units:
@@ -493,6 +559,13 @@ _COMMENTS = {
     "forces": "γ = (∂²L/∂v∂q) v + ∂²L/∂v∂t − ∂L/∂q − Q, so that M v̇ = Fᵀλ − γ  (3.3)",
     "f_accel": "f̈ = f_q v̇ + f_accel:  ∂ḟ/∂q v + ∂ḟ/∂t with ḟ = f_q v + f_t",
     "energy": "Jacobi integral vᵀ ∂L/∂v − L",
+}
+#: the same for a model with a kinematic map q̇ = T v
+_KINEMATIC_COMMENTS = {
+    **_COMMENTS,
+    "forces": "γ: Hamel's equations in v, so that M v̇ = Fᵀλ − γ with q̇ = T v",
+    "f_accel": "f̈ = f_q T v̇ + f_accel:  (d/dt (f_q T)) v + d/dt f_t along q̇ = T v",
+    "kinematics": "T of q̇ = T v",
 }
 
 
@@ -605,7 +678,7 @@ class _LocalNames:
         return lines
 
 
-def _function(piece: str, expr, names: _LocalNames) -> tuple[str, int]:
+def _function(piece: str, expr, names: _LocalNames, kinematic: bool = False) -> tuple[str, int]:
     """One ``@njit`` function: unpacking, common subexpressions, then the outputs; and its
     number of operations (``sympy.count_ops`` of the subexpressions and the outputs)."""
     if piece == "energy":
@@ -652,7 +725,8 @@ def _function(piece: str, expr, names: _LocalNames) -> tuple[str, int]:
                 for j in range(i):
                     if M[j, i] != 0 or not zeros:
                         body.append(f"out[{i}, {j}] = out[{j}, {i}]")
-    comment = [f"# {_COMMENTS[piece]}"] if piece in _COMMENTS else []
+    comments = _KINEMATIC_COMMENTS if kinematic else _COMMENTS
+    comment = [f"# {comments[piece]}"] if piece in comments else []
     lines = comment + body
     ops = sum(sp.count_ops(e) for e in [*reduced, *(r for _, r in replacements)])
     return (f"@njit(cache=True)\ndef {piece}({_signature(piece)}):\n"

@@ -450,3 +450,81 @@ def test_a_sum_of_thousands_of_terms_is_written_as_partial_sums(tmp_path, monkey
             va = np.asarray(a._value(piece, 0.0, xs, a.default_params(), python=True))
             vb = np.asarray(b._value(piece, 0.0, xs, b.default_params(), python=True))
             assert va.tobytes() == vb.tobytes(), piece
+
+
+# ---------------------------------------------------------------- quasi-velocities
+def test_a_quaternion_spec_derives_the_hand_written_top(tmp_path):
+    """The heavy top's Lagrangian in body angular velocities and the norm's rate, with
+    the map ``q̇ = ½ p ⊗ (w, ω)``: Hamel's equations give the hand-written scene's
+    gyroscopic and gravity terms (Euler's equations) at states off the manifold
+    (|p| ≠ 1, w ≠ 0), its f_accel and map; the energy differs by the norm's ½ μ w²."""
+    model = generated(tmp_path, ROOT / "tests" / "models" / "heavy_top_spec.py")
+    top = load_scene("heavy_top")
+    assert model.kinematic and model.velocities == ("w", "omega_x", "omega_y", "omega_z")
+    assert model.check().ok
+    rng = np.random.default_rng(5)
+    p = top.default_params()
+    for _ in range(4):
+        x = top.reference_state(p) + 0.1 * rng.standard_normal(8)
+        for piece in ("mass", "forces", "f", "f_q", "f_accel", "kinematics"):
+            np.testing.assert_allclose(model.evaluate(piece, 0.0, x, p),
+                                       top.evaluate(piece, 0.0, x, p), rtol=0, atol=1e-13,
+                                       err_msg=piece)  # fmt: skip
+        assert abs(top.evaluate("forces", 0.0, x, p)).max() > 0.1  # a real comparison
+        half_w2 = 0.5 * p[3] * x[4] ** 2
+        assert model.evaluate("energy", 0.0, x, p) == pytest.approx(
+            top.evaluate("energy", 0.0, x, p) + half_w2, rel=1e-13)
+    np.testing.assert_array_equal(model.reference_state(p), top.reference_state(p))
+
+
+def test_hamel_terms_of_polar_quasi_velocities_in_closed_form():
+    """A pendulum in polar coordinates q = (r, θ) with the quasi-velocities v = (ṙ, r θ̇)
+    (T = diag(1, 1/r)), L* = ½ m (v_r² + v_θ²) + m g r cos θ: Hamel's equations are
+    ``m v̇_r − m v_θ²/r − m g cos θ = λ`` and ``m v̇_θ + m v_r v_θ / r + m g sin θ = 0``, so
+    γ = (−m v_θ²/r − m g cos θ, m v_r v_θ/r + m g sin θ); the constraint r = l has
+    f_q T = (1, 0) and f_accel = 0."""
+    (r, th), (vr, vt) = coordinates("r theta")
+    m, g, l = sp.symbols("m g l")
+    system = System("polar", q=[r, th], v=[vr, vt],
+                    kinematics=sp.Matrix([[1, 0], [0, 1 / r]]),
+                    lagrangian=m * (vr**2 + vt**2) / 2 + m * g * r * sp.cos(th),
+                    holonomic=[r - l], params={m: 2.0, g: 9.81, l: 1.5},
+                    reference_state=[l, sp.Rational(1, 2), 0, l])  # fmt: skip
+    pieces = system.derive()
+    gamma = sp.Matrix([-m * vt**2 / r - m * g * sp.cos(th), m * vr * vt / r + m * g * sp.sin(th)])
+    assert sp.simplify(pieces["forces"] - gamma) == sp.zeros(2, 1)
+    assert sp.simplify(pieces["f_q"] * pieces["kinematics"]) == sp.Matrix([[1, 0]])
+    assert pieces["f_accel"] == sp.zeros(1, 1)
+    assert sp.simplify(pieces["energy"] - (m * (vr**2 + vt**2) / 2 - m * g * r * sp.cos(th))) == 0
+
+
+def test_a_generated_polar_pendulum_in_quasi_velocities_swings_as_the_cartesian_one(tmp_path):
+    """The polar pendulum above generated and integrated (T = diag(1, 1/r) depends on the
+    state): its angle follows the Cartesian pendulum scene's from the same start, θ₀ = 0.5,
+    θ̇₀ = 1, over 2 s."""
+    (r, th), (vr, vt) = coordinates("r theta")
+    g, l = sp.symbols("g l")
+    system = System("polar_pendulum", q=[r, th], v=[vr, vt],
+                    kinematics=sp.Matrix([[1, 0], [0, 1 / r]]),
+                    lagrangian=(vr**2 + vt**2) / 2 + g * r * sp.cos(th), holonomic=[r - l],
+                    params={g: 9.81, l: 1.0},
+                    reference_state=[l, sp.Rational(1, 2), 0, l])  # fmt: skip
+    polar = stabdae.load_model(system.write(tmp_path / "polar_pendulum.py"))
+    cartesian = load_scene("pendulum")
+    law = stabdae.baumgarte(10.0, 1.0)
+    a = stabdae.integrate(polar, None, law, "rk4", 1e-3, 2.0, 0.1)
+    b = stabdae.integrate(cartesian, None, law, "rk4", 1e-3, 2.0, 0.1)
+    theta = np.arctan2(b.x.values[:, 0], -b.x.values[:, 1])
+    assert np.ptp(theta) > 0.5  # it swings
+    np.testing.assert_allclose(a.x.values[:, 1], theta, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(a.x.values[:, 0], 1.0, rtol=0, atol=1e-12)
+
+
+def test_a_kinematic_map_must_be_square_and_free_of_velocities():
+    (r, th), (vr, vt) = coordinates("r theta")
+    args = dict(q=[r, th], v=[vr, vt], lagrangian=(vr**2 + vt**2) / 2, holonomic=[r - 1],
+                reference_state=[1, 0, 0, 1])
+    with pytest.raises(SymbolicError, match=r"kinematics must be an n × n = 2 × 2 matrix"):
+        System("bad", kinematics=sp.Matrix([[1, 0]]), **args)
+    with pytest.raises(SymbolicError, match=r"kinematics\[1, 1\] \(T\(q, t\): no velocities\)"):
+        System("bad", kinematics=sp.Matrix([[1, 0], [0, vr]]), **args)

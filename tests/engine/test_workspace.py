@@ -13,20 +13,22 @@ import stabdae
 from conftest import compiled_only, load_scene
 from stabdae._laws import bind_law
 from stabdae.engine.rhs import kernels_for
-from stabdae.engine.workspace import LAYOUT, shapes
+from stabdae.engine.workspace import KINEMATIC, LAYOUT, shapes
 
 
 # ---------------------------------------------------------------- the named workspace
 @compiled_only
-@pytest.mark.parametrize("name", ["pendulum", "rolling_disk"])
+@pytest.mark.parametrize("name", ["pendulum", "rolling_disk", "heavy_top"])
 def test_heap_and_stack_workspaces_follow_one_declaration(name):
     """The heap and stack workspaces of a model have the buffers of the declaration, by
-    name, with its shapes."""
+    name, with its shapes; the kinematic map's only where a model declares one."""
     model = load_scene(name)
     K = kernels_for(model, bind_law(stabdae.none(), model))
     heap = K.make_workspace()
-    expect = shapes(model.n, model.m, model.k)
-    assert list(heap._fields) == [n for n, _, _ in LAYOUT]
+    expect = shapes(model.n, model.m, model.k, model.kinematic)
+    layout = LAYOUT + (KINEMATIC if model.kinematic else ())
+    assert model.kinematic == (name == "heavy_top")
+    assert list(heap._fields) == [n for n, _, _ in layout]
     assert {f: getattr(heap, f).shape for f in heap._fields} == expect
     stack_workspace = K.stack_workspace
 

@@ -1,12 +1,14 @@
 """The checks that guard the project itself can fail: CI's docs build counts warnings, the
 docs toolchain is pinned, and the mutation runner never calls a mutant caught when no test
-ran."""
+ran, nor when its tests could not run, and writes its results file from a full run."""
 
 from __future__ import annotations
 
 import re
 import shlex
+import subprocess
 import sys
+import time
 
 import pytest
 
@@ -15,7 +17,7 @@ from conftest import ROOT
 sys.path.insert(0, str(ROOT / "tests" / "mutation"))
 from generate import GROUPS, generate  # noqa: E402
 from mutants import MUTANTS  # noqa: E402
-from run import outcome_of  # noqa: E402
+from run import outcome_of, results_header  # noqa: E402
 
 
 def _mkdocs_lines(text: str) -> list[list[str]]:
@@ -55,7 +57,9 @@ def test_docs_toolchain_is_pinned_where_it_is_installed():
 @pytest.mark.parametrize(("code", "out", "expected"), [
     (0, "3 passed", "SURVIVED"),
     (1, "FAILED tests/test_x.py::test_a - assert\n1 failed", "caught"),
-    (2, "ERROR tests/test_x.py - ImportError\n1 error", "caught"),
+    (1, "ERROR tests/test_x.py::test_a - fixture failed\n1 error", "caught"),
+    (2, "ERROR tests/test_x.py - ImportError\n1 error", "BROKEN"),
+    (3, "INTERNALERROR> Traceback", "BROKEN"),
     (4, "ERROR: file or directory not found: tests/test_gone.py", "NOT RUN"),
     (5, "no tests ran in 0.01s", "NOT RUN"),
     (-11, "Fatal Python error: Segmentation fault", "caught (crash)"),
@@ -65,6 +69,14 @@ def test_mutation_outcomes(code, out, expected):
     outcome, _ = outcome_of(code, out)
     assert outcome.split(" (")[0] == expected.split(" (")[0], outcome
     assert outcome.startswith("caught") == expected.startswith("caught")
+
+
+def test_the_results_file_names_the_commit_and_the_date_of_its_run():
+    head = "\n".join(results_header("`python tests/mutation/run.py`"))
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()
+    assert commit and commit in head
+    assert time.strftime("%Y-%m-%d") in head and "Not edited by hand" in head
 
 
 def test_mutants_name_tests_that_exist():

@@ -965,4 +965,33 @@ MUTANTS = [
            "    for b in range(max(first, 0) + 1, NBINS):\n",
            ('tests/engine/test_decay.py::test_a_members_start_clears_its_ladder_from_the_level_given',),
            "a member's start leaves the lowest level it should clear"),
+    # ---- quasi-velocities: the kinematic map q̇ = T v
+    Mutant("kinematic-qdot-is-v",
+           E + "rhs.py",
+           "                xdot[j] = vq[j]\n                xdot[n + j] = s\n"
+           "        if LAW == LAW_ACPR:",
+           "                xdot[j] = v[j]\n                xdot[n + j] = s\n"
+           "        if LAW == LAW_ACPR:",
+           ('tests/drivers/test_reference_rhs.py::test_rhs_with_a_kinematic_map_equals_the_numpy_reference',),
+           "the dense right-hand side writes q̇ = v instead of T v"),
+    Mutant("kinematic-hq-times-v",
+           E + "rhs.py",
+           "                            s = fma(-hq[i, j], vq[j], s)\n"
+           "                    rl[m + i] = s",
+           "                            s = fma(-hq[i, j], v[j], s)\n"
+           "                    rl[m + i] = s",
+           ('tests/drivers/test_reference_rhs.py::test_rhs_with_a_kinematic_map_equals_the_numpy_reference',),
+           "the velocity products h_q v instead of h_q T v"),
+    Mutant("kinematic-projection-without-T",
+           E + "rhs.py",
+           "                    if level == 0:\n                        Tw = ws.T",
+           "                    if False:\n                        Tw = ws.T",
+           ('tests/drivers/test_rigid_bodies.py::test_projection_and_the_correction_of_ascher_et_al_follow_the_map',),
+           "coordinate projection moves q by δv instead of T δv"),
+    Mutant("kinematic-check-along-v",
+           S + "_check.py",
+           "            xx = np.concatenate([q + (s - t) * (T0 @ v), v])\n            qdot",
+           "            xx = np.concatenate([q + (s - t) * v, v])\n            qdot",
+           ('tests/drivers/test_rigid_bodies.py::test_check_passes_on_the_quaternion_models',),
+           "check differentiates ḟ along q̇ = v instead of T v"),
 ]

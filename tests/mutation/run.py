@@ -6,7 +6,11 @@ once in its file) in a fresh copy of the tracked and untracked files, then runs 
 selection with ``pytest -x`` against that copy (its own kernel cache, so that nothing
 compiled from the real source is reused).  A mutant is *caught* when a test fails; it is
 *NOT RUN* when pytest ran no test (exit 4: a path that does not exist; exit 5: a
-selection that matches nothing), which fails the run like a survivor.
+selection that matches nothing), and *BROKEN* when pytest could not run its tests (exit 2:
+a collection error or an interruption; exit 3: an internal error): neither says a test
+caught the change, and both fail the run like a survivor.  ``--write-results`` writes
+``RESULTS.md`` from a full run (every mutant of the list, or of a generated sample), with
+the commit and the date at its top; a partial run cannot write it.
 """
 
 from __future__ import annotations
@@ -31,6 +35,9 @@ ROOT = Path(__file__).resolve().parents[2]
 #: pytest's exit codes that mean no test of the selection ran
 NOT_RUN = {4: "usage error: a test path or option that does not exist",
            5: "no test collected: the selection matches nothing"}
+#: pytest's exit codes that mean its tests could not run: no test caught anything
+BROKEN = {2: "a collection error or an interruption", 3: "pytest's internal error"}
+RESULTS = Path(__file__).resolve().parent / "RESULTS.md"
 
 
 def _copy_tree(dest: Path) -> None:
@@ -55,6 +62,9 @@ def outcome_of(code, out: str) -> tuple[str, str]:
         return f"NOT RUN ({NOT_RUN[code]})", last
     if code == "timeout":
         return "timeout", ""
+    if code in BROKEN:
+        # a test file that does not import, or pytest itself failing, catches nothing
+        return f"BROKEN ({BROKEN[code]}: exit {code})", last
     if failed:
         return "caught", failed[0]
     if code < 0 or "Fatal Python error" in out or "Segmentation fault" in out:
@@ -102,7 +112,11 @@ def main(argv=None) -> int:
                     help="run a generated sample (generate.py) instead of the hand list")
     ap.add_argument("--per-module", type=int, default=8,
                     help="with --generate: mutants per module group (default 8)")
+    ap.add_argument("--write-results", action="store_true",
+                    help=f"write {RESULTS.name} from this run (a full run only)")
     args = ap.parse_args(argv)
+    if args.write_results and args.names:
+        ap.error("--write-results needs a full run: name no mutants")
     pool = MUTANTS if args.generate is None else generate(args.generate, args.per_module)
     chosen = [m for m in pool if not args.names or m.name in args.names]
     unknown = set(args.names) - {m.name for m in pool}
@@ -124,17 +138,42 @@ def main(argv=None) -> int:
 
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         results = list(pool.map(one, chosen))
+    survived = [r["name"] for r in results if not r["outcome"].startswith("caught")]
+    lines = table(chosen, results) + [
+        "", f"{len(results) - len(survived)} of {len(results)} caught in "
+        f"{time.perf_counter() - start:.0f} s; not caught: {', '.join(survived) or 'none'}"]
+    print("\n" + "\n".join(lines))
+    if args.write_results:
+        what = (f"`python tests/mutation/run.py --generate {args.generate} --per-module "
+                f"{args.per_module}`" if args.generate is not None
+                else "`python tests/mutation/run.py` (the hand-written list)")
+        RESULTS.write_text("\n".join(results_header(what) + lines) + "\n")
+        print(f"written to {RESULTS}")
+    return 1 if survived else 0
+
+
+def table(chosen, results) -> list[str]:
+    """The run as a Markdown table, one row per mutant."""
     width = max(len(m.name) for m in chosen)
-    print(f"\n| {'mutant':{width}s} | place | change | outcome | caught by | s |")
-    print(f"|{'-' * (width + 2)}|---|---|---|---|---|")
+    rows = [f"| {'mutant':{width}s} | place | change | outcome | caught by | s |",
+            f"|{'-' * (width + 2)}|---|---|---|---|---|"]
     for m, r in zip(chosen, results):
         place = m.file.removeprefix("src/") + (f":{m.line}" if m.line else "")
-        print(f"| {m.name:{width}s} | `{place}` | {m.what} | "
-              f"{r['outcome']} | {r['test']} | {r['seconds']:.0f} |")  # fmt: skip
-    survived = [r["name"] for r in results if not r["outcome"].startswith("caught")]
-    print(f"\n{len(results) - len(survived)} of {len(results)} caught in "
-          f"{time.perf_counter() - start:.0f} s; survivors: {', '.join(survived) or 'none'}")
-    return 1 if survived else 0
+        rows.append(f"| {m.name:{width}s} | `{place}` | {m.what} | {r['outcome']} | "
+                    f"{r['test']} | {r['seconds']:.0f} |")
+    return rows
+
+
+def results_header(what: str) -> list[str]:
+    """RESULTS.md's top: the commit and the date of the run, and the command."""
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip() or "unknown"
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                           cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    return ["# Mutation results", "",
+            f"Written by the runner from one full run: {what}, at commit {commit}"
+            + (" with uncommitted changes" if dirty else "")
+            + f", {time.strftime('%Y-%m-%d')}.  Not edited by hand.", ""]
 
 
 if __name__ == "__main__":

@@ -483,14 +483,17 @@ def _pieces(model, sparse: bool) -> Pieces:
                     for i in range(cols):
                         s = fma(Y[j, i], rhs_[i], s)
                     dx[j] = s
-                if HAS_KIN and level == 0:  # a step in v's coordinates moves q by T δv
-                    Tw = ws.T
-                    for j in range(n):
-                        s = -0.0
-                        for c in range(n):
-                            s = fma(Tw[j, c], dx[c], s)
-                        x[j] -= s
-                else:
+                moved = False
+                if HAS_KIN:  # a step in v's coordinates moves q by T δv
+                    if level == 0:
+                        Tw = ws.T
+                        for j in range(n):
+                            s = -0.0
+                            for c in range(n):
+                                s = fma(Tw[j, c], dx[c], s)
+                            x[j] -= s
+                        moved = True
+                if not moved:
                     for j in range(n):
                         x[level * n + j] -= dx[j]
         return _OK
@@ -682,7 +685,10 @@ def _build(model, spec: Spec) -> Kernels:
         q, v, Mw, z, fq, hv, hq = ws.q, ws.v, ws.M, ws.z, ws.fq, ws.hv, ws.hq
         Y, S, rl, g, sm, sk = ws.Y, ws.S, ws.rl, ws.g, ws.sm, ws.sk
         Aw, W, Lh = ws.Aw, ws.W, ws.Lh
-        vq = ws.qd if HAS_KIN else v  # q̇
+        if HAS_KIN:  # q̇ (a model without a map has no buffer for it: branch pruned)
+            vq = ws.qd
+        else:
+            vq = v
         residual(t, x, p, ws, g)
         forces(t, q, v, p, z)
 

@@ -10,8 +10,9 @@ constructors and every reader follow the one declaration.
 
 Sizes: ``n`` coordinates, ``m`` holonomic and ``k`` nonholonomic constraints,
 ``r = m + k``, ``ng = 2m + k`` residual components; ``mk = max(m, 1)`` and
-``kk = max(k, 1)``, so that the buffers of an absent block keep a harmless size 1, and
-``nt``, ``n`` for a model with a kinematic map ``q̇ = T(q, t) v`` and 1 without.
+``kk = max(k, 1)``, so that the buffers of an absent block keep a harmless size 1.  A
+model with a kinematic map ``q̇ = T(q, t) v`` has the buffers of :data:`KINEMATIC` too,
+in a :class:`KinematicWorkspace` (a model without one compiles no trace of them).
 
 :func:`stack1`, :func:`stack2` and :func:`stack_int1` give arrays on the stack of the
 function that calls them (inline that function at the numba IR level, as
@@ -30,8 +31,8 @@ from numba.extending import intrinsic
 from .jit import internal
 from .source import exec_source
 
-__all__ = ["LAYOUT", "Workspace", "builders", "copy_inputs", "copy_tableau", "sizes", "stack1",
-           "stack2", "stack_int1"]
+__all__ = ["KINEMATIC", "LAYOUT", "KinematicWorkspace", "Workspace", "builders", "copy_inputs",
+           "copy_tableau", "sizes", "stack1", "stack2", "stack_int1"]
 
 #: (name, shape in the sizes of :func:`sizes`, what it holds)
 LAYOUT = (
@@ -55,25 +56,33 @@ LAYOUT = (
     ("ev", ("r",), "eigenvalues of S (least-squares multiplier)"),
     ("mu", ("r",), "size r: the correction's and the projection's velocity right side; "
      "the least-squares multiplier's scratch"),
-    ("T", ("nt", "nt"), "the kinematic map T(q, t) of q̇ = T v"),
-    ("fr", ("mk", "nt"), "∂f/∂q as the model writes it, before F's rows f_q T"),
-    ("qd", ("nt",), "q̇ = T v"),
 )  # fmt: skip
+#: the buffers of a model with a kinematic map, after :data:`LAYOUT`'s
+KINEMATIC = (
+    ("T", ("n", "n"), "the kinematic map T(q, t) of q̇ = T v"),
+    ("fr", ("mk", "n"), "∂f/∂q as the model writes it, before F's rows f_q T"),
+    ("qd", ("n",), "q̇ = T v"),
+)
 
 Workspace = namedtuple("Workspace", [name for name, _, _ in LAYOUT])
 Workspace.__doc__ = "The named buffers of :data:`LAYOUT` (heap or stack arrays)."
+KinematicWorkspace = namedtuple("KinematicWorkspace",
+                                [name for name, _, _ in LAYOUT + KINEMATIC])
+KinematicWorkspace.__doc__ = "The buffers of :data:`LAYOUT` and :data:`KINEMATIC`."
 
 
-def sizes(n: int, m: int, k: int, kinematic: bool = False) -> dict:
-    """The sizes :data:`LAYOUT` is written in (``kinematic``: the model has a map T)."""
+def sizes(n: int, m: int, k: int) -> dict:
+    """The sizes :data:`LAYOUT` is written in."""
     return {"n": n, "m": m, "k": k, "r": m + k, "ng": 2 * m + k, "mk": max(m, 1),
-            "kk": max(k, 1), "nt": n if kinematic else 1}  # fmt: skip
+            "kk": max(k, 1)}  # fmt: skip
 
 
 def shapes(n: int, m: int, k: int, kinematic: bool = False) -> dict:
-    """``name -> shape`` of every buffer for a model of sizes ``n, m, k``."""
-    dim = sizes(n, m, k, kinematic)
-    return {name: tuple(dim[d] for d in shape) for name, shape, _ in LAYOUT}
+    """``name -> shape`` of every buffer for a model of sizes ``n, m, k`` (and a
+    kinematic map: ``kinematic``)."""
+    dim = sizes(n, m, k)
+    layout = LAYOUT + (KINEMATIC if kinematic else ())
+    return {name: tuple(dim[d] for d in shape) for name, shape, _ in layout}
 
 
 def _builder_source(n: int, m: int, k: int, kinematic: bool) -> str:
@@ -81,11 +90,12 @@ def _builder_source(n: int, m: int, k: int, kinematic: bool) -> str:
     for shape in shapes(n, m, k, kinematic).values():
         heap.append(f"np.empty({shape})")
         stack.append(f"stack{len(shape)}({', '.join(map(str, shape))})")
+    cls = "KinematicWorkspace" if kinematic else "Workspace"
     return (
         "def make_workspace():\n"
-        f"    return Workspace({', '.join(heap)})\n\n"
+        f"    return {cls}({', '.join(heap)})\n\n"
         "def stack_workspace():\n"
-        f"    return Workspace({', '.join(stack)})\n"
+        f"    return {cls}({', '.join(stack)})\n"
     )
 
 
@@ -97,7 +107,8 @@ def builders(n: int, m: int, k: int, kinematic: bool = False):
     buffers belong to the caller)."""
     ns = exec_source(_builder_source(n, m, k, kinematic),
                      f"workspace_n{n}_m{m}_k{k}" + ("_T" if kinematic else ""),
-                     {"np": np, "Workspace": Workspace, "stack1": stack1,
+                     {"np": np, "Workspace": Workspace,
+                      "KinematicWorkspace": KinematicWorkspace, "stack1": stack1,
                       "stack2": stack2})  # fmt: skip
     return (internal(error_model="numpy")(ns["make_workspace"]),
             njit(inline="always")(ns["stack_workspace"]))  # fmt: skip
