@@ -36,7 +36,7 @@ from ._model import Model
 from ._raised import first_raising_member, model_raised, stage_finder
 from ._schema import schema_entry
 from ._sequential import Sequential, decide
-from .engine.ahead import sampler_ahead
+from .engine.ahead import sampler_ahead, wait_share
 from .engine.crash import guard
 from .engine.decay import Record
 from .engine.ensemble.block import BLOCK, ensemble_kernel_for
@@ -52,7 +52,7 @@ from .engine.ensemble.groups import (
     outputs,
 )
 from .engine.ensemble.lanes import LANES, adaptive_block_for
-from .engine.jit import compile_seconds
+from .engine.jit import compile_seconds, compiling_elsewhere
 from .engine.rk.steps import integrator_for
 from .engine.sampler import CHUNK, SAMPLING_RTOL, draw_alphas, residual_rows_for, sampler_for
 from .engine.threads import default_threads, run_chunks
@@ -807,9 +807,11 @@ def _members(run: _RunSpec, x0, reference: bool = True):
         try:
             clock = time.perf_counter()
             g_ref = run.mode.reference(run)
-            # the sampler is the smaller kernel: a helper not done after as long again is
-            # stopped (the placing then compiles the sampler here)
-            ahead.join(max(5.0, time.perf_counter() - clock))
+            # the sampler is the smaller kernel: a helper not done a share of the kernel's
+            # time later is stopped (the placing then compiles the sampler here); the wait
+            # is compile time
+            with compiling_elsewhere():
+                ahead.join(wait_share() * (time.perf_counter() - clock))
         finally:
             ahead.stop()
         x0, alpha0, status = _place(model, targets, p, t0, run.threads)

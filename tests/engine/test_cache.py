@@ -100,7 +100,7 @@ def test_a_helper_process_compiles_the_sampler_while_the_kernel_compiles(tmp_pat
     model_file.write_text((scene_dir() / "pendulum.py").read_text())
     alone = _child(model_file, tmp_path / "alone")
     assert alone["sampler"] == [0, 1] and alone["misses"] == 2
-    helped = _child(model_file, tmp_path / "helped", ahead="1")
+    helped = _child(model_file, tmp_path / "helped", ahead="always")  # (the suite loads it)
     assert helped["sampler"] == [1, 0] and helped["hits"] == 1 and helped["misses"] == 1
     assert helped["x_final"] == alone["x_final"]
     print(f"first ensemble alone {alone['seconds']:.2f} s, helped {helped['seconds']:.2f} s")
@@ -117,6 +117,7 @@ def test_the_helper_starts_only_where_it_can_gain_and_a_failed_one_is_waited_out
     from stabdae.engine.sampler import sampler_for
 
     monkeypatch.setattr(ahead, "_usable_cpus", lambda: 2)
+    monkeypatch.setattr(ahead, "busy_cpus", lambda: 0.2)  # this process alone on the machine
     monkeypatch.setenv("STABDAE_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setenv(ahead.ENV, "1")
     model_file = tmp_path / "pendulum_guard.py"
@@ -134,11 +135,60 @@ def test_the_helper_starts_only_where_it_can_gain_and_a_failed_one_is_waited_out
     monkeypatch.setattr(ahead, "_usable_cpus", lambda: 1)
     assert ahead.sampler_ahead(model, sampler, kernel) is None
     monkeypatch.setattr(ahead, "_usable_cpus", lambda: 2)
+    with monkeypatch.context() as m:  # another process keeps the second CPU busy
+        m.setattr(ahead, "busy_cpus", lambda: 1.0)
+        assert ahead.sampler_ahead(model, sampler, kernel) is None
+        m.setenv(ahead.ENV, "always")
+        started = ahead.sampler_ahead(model, sampler, kernel)
+        assert started is not None
+        started.stop()
     anonymous = model.replace()  # built in this process: no file to load it from
     assert ahead.sampler_ahead(anonymous, sampler_for(anonymous), kernel) is None
     model._origin = (str(model_file), "no_such_model")
     helper = ahead.sampler_ahead(model, sampler, kernel)
     assert helper is not None and helper.join(60) is False
+
+
+@pytest.mark.parametrize(("cpus", "busy", "idle"), [
+    (2, 0.0, True), (2, 0.5, True), (2, 0.6, False), (2, 1.0, False), (2, 6.5, False),
+    (1, 0.0, False), (4, 2.5, True), (4, 2.6, False), (16, 14.5, True),
+])  # fmt: skip
+def test_the_helper_needs_a_cpu_idle_beside_this_process(cpus, busy, idle):
+    """A CPU is idle beside this process when other work leaves more than one and a half
+    of the usable CPUs (one for this process's compiling): on a machine other work keeps
+    busy the helper would compete with this process, which the first ensemble waits for."""
+    from stabdae.engine.ahead import idle_cpu
+
+    assert idle_cpu(cpus, busy) is idle
+
+
+def test_a_busy_process_beside_is_seen_as_a_busy_cpu():
+    """What the rule reads: a process spinning beside this one keeps about one CPU busy
+    (this process sleeps while the counters are read, so its own share is not counted)."""
+    import subprocess
+    import sys
+    import time
+
+    from stabdae.engine.ahead import busy_cpus
+
+    spin = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    try:
+        time.sleep(0.3)
+        assert busy_cpus() >= 0.6
+    finally:
+        spin.kill()
+        spin.wait()
+
+
+def test_waiting_for_a_helper_counts_as_compiling():
+    import time
+
+    from stabdae.engine.jit import compile_seconds, compiling_elsewhere
+
+    before = compile_seconds()
+    with compiling_elsewhere():
+        time.sleep(0.2)
+    assert compile_seconds() - before >= 0.2
 
 
 def _scaled(c):

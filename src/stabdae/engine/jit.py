@@ -9,6 +9,7 @@ the intrinsics have Python stand-ins (:mod:`.fma`, :mod:`.workspace`).
 
 from __future__ import annotations
 
+import contextlib
 import inspect
 import threading
 import time
@@ -21,8 +22,8 @@ from numba.core.compiler import Flags
 from numba.core.dispatcher import Dispatcher, _FunctionCompiler
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["JIT", "compile_seconds", "from_python", "internal", "is_njit", "python_function",
-           "variant"]
+__all__ = ["JIT", "compile_seconds", "compiling_elsewhere", "from_python", "internal", "is_njit",
+           "python_function", "variant"]
 
 #: False when numba's JIT is switched off (``NUMBA_DISABLE_JIT=1``)
 JIT = not config.DISABLE_JIT
@@ -178,6 +179,17 @@ class _CompileClock(event.Listener):
 
 _CLOCK = _CompileClock()
 event.register("numba:compiler_lock", _CLOCK)
+
+
+@contextlib.contextmanager
+def compiling_elsewhere():
+    """Book the time inside the block as compiling (:func:`compile_seconds`): this process
+    waits for another one that compiles its code (:mod:`.ahead`)."""
+    _CLOCK.on_start(None)
+    try:
+        yield
+    finally:
+        _CLOCK.on_end(None)
 
 
 def compile_seconds() -> float:
