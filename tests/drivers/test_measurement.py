@@ -525,6 +525,30 @@ def test_a_members_measures_do_not_depend_on_its_place_in_the_ensemble(tau):
         np.testing.assert_array_equal(forward[name].values, backward[name].values, name)
 
 
+def test_gamma_and_beta_bound_every_saved_norm_of_their_window():
+    """γ's definition: ``‖g(t)‖ ≤ γ e^{−β (t − t_start)}`` over the fit window.  Under
+    Baumgarte's law at ξ = 1 the affine system's residual is a Jordan block's,
+    ``‖g‖ ∝ (1 + ωt) e^{−ωt}``, so ``‖g‖ e^{βt}`` grows over the window and γ lies above
+    the largest norm (a prefactor read as the largest norm would not bound the rest)."""
+    from models.affine import model
+
+    ds = stabdae.ensemble(model, stabdae.baumgarte(10.0, 1.0, k=10.0), "rk4", 1e-3, 3.0,
+                          members=16, seed=0, save_dt=0.01)  # fmt: skip
+    t = ds.time.values - float(ds.time.values[0])
+    norms = ds.residual_norm.values.astype(float)
+    checked = 0
+    for j in range(ds.sizes["member"]):
+        gamma, beta = float(ds.gamma.values[j]), float(ds.beta.values[j])
+        lo = float(ds.fit_start.values[j]) - float(ds.time.values[0])
+        hi = float(ds.fit_end.values[j]) - float(ds.time.values[0])
+        inside = (t >= lo) & (t <= hi)
+        bound = gamma * np.exp(-beta * (t[inside] - lo))
+        assert (norms[j, inside] <= bound * (1 + 1e-5)).all(), j
+        assert gamma > 2.0 * norms[j, inside].max(), j
+        checked += int(inside.sum())
+    assert checked > 16 * 20
+
+
 @pytest.mark.parametrize("scheme", ["euler", "rk4"])
 def test_gamma_of_an_exact_decay_is_the_initial_norm_down_to_roundoff(scheme):
     """On the affine system without its holonomic constraint the residual is h alone, and
