@@ -16,7 +16,7 @@ axial one ``C ωz`` are first integrals.
 The reference state is a steady precession: the axis at θ₀ = 0.5 rad from the upward
 vertical, spinning with ωz = 10 rad/s about it and precessing about the vertical at the
 slow root Ω of ``A Ω² cos θ₀ − C ωz Ω + mgl = 0``, so that the axis stays at θ₀ and turns
-about e_z at the constant rate Ω (:func:`precession_rate`).
+about e_z at the constant rate Ω (:func:`precession_rate`, :func:`exact_axis`).
 """
 
 import math
@@ -86,6 +86,16 @@ def precession_rate(p) -> float:
     A, C, mgl = p[0], p[1], p[2]
     c = math.cos(THETA0)
     return (C * SPIN - math.sqrt((C * SPIN) ** 2 - 4.0 * A * mgl * c)) / (2.0 * A * c)
+
+
+def exact_axis(t, p):
+    """The symmetry axis in the world frame at times ``t`` of the steady precession from
+    the reference state: at θ₀ from the vertical, turning about it at Ω; shape
+    (len(t), 3)."""
+    t = np.asarray(t, dtype=float)
+    th, om = THETA0, precession_rate(p)
+    return np.stack([np.sin(th) * np.sin(om * t), -np.sin(th) * np.cos(om * t),
+                     np.full_like(t, np.cos(th))], axis=1)
 
 
 def reference_state(p):

@@ -54,13 +54,8 @@ def top_row(scheme, tau) -> dict:
     top, p = _module(model), model.default_params()
     ds, wall = _run(model, scheme, tau, 0.05)
     t, X = ds.time.values, ds.x.values
-    th, om = top.THETA0, top.precession_rate(p)
-    exact = np.stack([np.sin(th) * np.sin(om * t), -np.sin(th) * np.cos(om * t),
-                      np.full_like(t, np.cos(th))], axis=1)  # fmt: skip
-    unit = X[:, :4] / np.linalg.norm(X[:, :4], axis=1, keepdims=True)
-    p0, p1, p2, p3 = unit.T
-    axis = np.stack([2 * (p1 * p3 + p0 * p2), 2 * (p2 * p3 - p0 * p1),
-                     p0**2 - p1**2 - p2**2 + p3**2], axis=1)  # fmt: skip
+    exact = top.exact_axis(t, p)
+    axis = rigid.rotations(X)[:, :, 2]  # R(p/|p|) e₃
     A, C = p[0], p[1]
     L = rigid.angular_momentum(X, np.diag([A, A, C]))
     E = ds.energy.values

@@ -242,13 +242,15 @@ def _check_state(model: Model, report: CheckReport, i: int, x, t: float, p) -> N
 
         T0 = ev("kinematics", t, x, p)  # the identity without a kinematic map
 
-        def fdot(s):  # ḟ along the motion q(s) = q + (s − t) T v at fixed v
-            xx = np.concatenate([q + (s - t) * (T0 @ v), v])
-            qdot = ev("kinematics", s, xx, p) @ v if model.kinematic else v
-            return ev("f_q", s, xx, p) @ qdot + ev("f_t", s, xx, p)
+        def moved(s):  # the state at s along the motion q(s) = q + (s − t) T v, v fixed
+            return np.concatenate([q + (s - t) * (T0 @ v), v])
+
+        def fdot(s):  # ḟ = f_q T v + f_t there (T v is v exactly where T = I)
+            xx = moved(s)
+            return ev("f_q", s, xx, p) @ (ev("kinematics", s, xx, p) @ v) + ev("f_t", s, xx, p)
 
         def terms_at(s):  # ḟ's terms, not ḟ itself (near zero on the manifold)
-            xx = np.concatenate([q + (s - t) * (T0 @ v), v])
+            xx = moved(s)
             Ts = np.abs(ev("kinematics", s, xx, p))
             return size(np.abs(ev("f_q", s, xx, p)) @ Ts @ np.abs(v)) + size(ev("f_t", s, xx, p))
 

@@ -36,7 +36,7 @@ from . import engine  # noqa: F401
 
 __all__ = [
     "angular_momentum", "norm", "norm_accel", "norm_row", "quaternion_about",
-    "quaternion_map", "rotation", "vertical",
+    "quaternion_map", "rotation", "rotations", "vertical",
 ]
 
 
@@ -105,6 +105,19 @@ def quaternion_about(axis, angle: float) -> np.ndarray:
     return np.concatenate([[np.cos(0.5 * angle)], np.sin(0.5 * angle) * a])
 
 
+def rotations(x, i: int = 0) -> np.ndarray:
+    """The rotation matrices (body to world) of the orientations ``p/|p|`` of states ``x``
+    (shape (2n,) or (..., 2n)), the quaternion at ``q[i:i+4]``: shape (..., 3, 3).
+    Python-side, for analysis (SciPy's rotations; in a model's functions
+    :func:`rotation`)."""
+    from scipy.spatial.transform import Rotation
+
+    X = np.asarray(x, dtype=np.float64)
+    p = X[..., i : i + 4].reshape(-1, 4)
+    R = Rotation.from_quat(p[:, [1, 2, 3, 0]]).as_matrix()  # SciPy's scalar last
+    return R.reshape(X.shape[:-1] + (3, 3))
+
+
 def angular_momentum(x, inertia, i: int = 0) -> np.ndarray:
     """The angular momentum in the world frame, ``R(p) I ω``, of states ``x`` (shape
     (2n,) or (..., 2n)) with the quaternion at ``q[i:i+4]`` and ``(w, ω)`` at
@@ -112,13 +125,6 @@ def angular_momentum(x, inertia, i: int = 0) -> np.ndarray:
     momentum is taken about)."""
     X = np.asarray(x, dtype=np.float64)
     n = X.shape[-1] // 2
-    p = X[..., i : i + 4] / np.linalg.norm(X[..., i : i + 4], axis=-1, keepdims=True)
     w = X[..., n + i + 1 : n + i + 4]
-    p0, p1, p2, p3 = (p[..., j] for j in range(4))
-    rows = (
-        (p0**2 + p1**2 - p2**2 - p3**2, 2 * (p1 * p2 - p0 * p3), 2 * (p1 * p3 + p0 * p2)),
-        (2 * (p1 * p2 + p0 * p3), p0**2 - p1**2 + p2**2 - p3**2, 2 * (p2 * p3 - p0 * p1)),
-        (2 * (p1 * p3 - p0 * p2), 2 * (p2 * p3 + p0 * p1), p0**2 - p1**2 - p2**2 + p3**2),
-    )
-    R = np.stack([np.stack(row, -1) for row in rows], -2)
-    return np.einsum("...ij,jk,...k->...i", R, np.asarray(inertia, dtype=np.float64), w)
+    inertia = np.asarray(inertia, dtype=np.float64)
+    return np.einsum("...ij,jk,...k->...i", rotations(X, i), inertia, w)

@@ -16,21 +16,11 @@ from stabdae import rigid
 LAW = stabdae.baumgarte(omega=10.0, xi=1.0)
 
 
-def _top_axis(X):
-    """The symmetry axis R(p/|p|) e₃ of the states X, shape (N, 3)."""
-    p = X[:, :4] / np.linalg.norm(X[:, :4], axis=1, keepdims=True)
-    p0, p1, p2, p3 = p.T
-    return np.stack([2 * (p1 * p3 + p0 * p2), 2 * (p2 * p3 - p0 * p1),
-                     p0**2 - p1**2 - p2**2 + p3**2], axis=1)  # fmt: skip
-
-
 def _precession_error(model, top, tau):
     ds = stabdae.integrate(model, None, LAW, "rk4", tau, 10.0, 0.5)
-    t, X = ds.time.values, ds.x.values
-    th, om = top.THETA0, top.precession_rate(model.default_params())
-    exact = np.stack([np.sin(th) * np.sin(om * t), -np.sin(th) * np.cos(om * t),
-                      np.full_like(t, np.cos(th))], axis=1)  # fmt: skip
-    return float(np.abs(_top_axis(X) - exact).max()), ds
+    axis = rigid.rotations(ds.x.values)[:, :, 2]  # R(p/|p|) e₃
+    exact = top.exact_axis(ds.time.values, model.default_params())
+    return float(np.abs(axis - exact).max()), ds
 
 
 def test_heavy_top_precesses_at_the_closed_form_rate_with_its_first_integrals():
@@ -72,6 +62,30 @@ def test_free_body_follows_the_elliptic_function_solution_through_its_flips():
     assert np.abs(L - L[0]).max() < 1e-11
     E = ds.energy.values
     assert np.abs(E - E[0]).max() < 1e-12 * E[0]
+
+
+def test_rotations_are_the_quaternions_rotations():
+    """The compiled rotation (and its third row, :func:`rigid.vertical`) against SciPy's
+    (the NumPy-side :func:`rigid.rotations` is SciPy's), and a turn about an axis by an
+    angle against Rodrigues' formula: for unit and non-unit quaternions."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        quat = rng.standard_normal(4) * rng.uniform(0.5, 2.0)
+        R = np.empty((3, 3))
+        rigid.rotation(quat, 0, R)
+        want = Rotation.from_quat(quat[[1, 2, 3, 0]]).as_matrix()
+        np.testing.assert_allclose(R, want, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(rigid.vertical(quat, 0), want[2], rtol=0, atol=1e-14)
+        state = np.concatenate([quat, np.zeros(4)])
+        np.testing.assert_allclose(rigid.rotations(state), want, rtol=0, atol=1e-14)
+    axis, angle = np.array([1.0, 2.0, 2.0]) / 3.0, 0.7
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    rodrigues = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    R = np.empty((3, 3))
+    rigid.rotation(rigid.quaternion_about(axis, angle), 0, R)
+    np.testing.assert_allclose(R, rodrigues, rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize("name", ["heavy_top", "free_body", "quaternion_ball"])

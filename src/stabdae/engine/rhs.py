@@ -483,19 +483,17 @@ def _pieces(model, sparse: bool) -> Pieces:
                     for i in range(cols):
                         s = fma(Y[j, i], rhs_[i], s)
                     dx[j] = s
-                moved = False
-                if HAS_KIN:  # a step in v's coordinates moves q by T δv
-                    if level == 0:
-                        Tw = ws.T
+                if HAS_KIN:
+                    if level == 0:  # a step in v's coordinates moves q by T δv (into q̇'s
+                        Tw, qd = ws.T, ws.qd  # buffer: the next sweep's residual refills it)
                         for j in range(n):
                             s = -0.0
                             for c in range(n):
                                 s = fma(Tw[j, c], dx[c], s)
-                            x[j] -= s
-                        moved = True
-                if not moved:
-                    for j in range(n):
-                        x[level * n + j] -= dx[j]
+                            qd[j] = s
+                        dx = qd
+                for j in range(n):
+                    x[level * n + j] -= dx[j]
         return _OK
 
     @internal(error_model="numpy")
